@@ -1,0 +1,1 @@
+"""iemd_ros: gyro-aided iEMD visual tracking (Yao & Dani) for ROS 2."""

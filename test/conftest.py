@@ -1,0 +1,25 @@
+"""Shared fixtures: location of the real data in ../shared (skipped cleanly when absent)."""
+from pathlib import Path
+
+import pytest
+
+SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+DATA = SHARED / "data"
+
+
+def _need(path: Path) -> Path:
+    if not path.exists():
+        pytest.skip(f"real data not available: {path} is absent (CI has ../shared beside the repo)")
+    return path
+
+
+@pytest.fixture
+def otb_root() -> Path:
+    """Folder of OTB sequences (../shared/data/otb)."""
+    return _need(DATA / "otb")
+
+
+@pytest.fixture
+def imu_root() -> Path:
+    """Folder of camera + gyro recordings (../shared/data/imu)."""
+    return _need(DATA / "imu")
