@@ -1,1 +1,7 @@
-"""iemd_ros: gyro-aided iEMD visual tracking (Yao & Dani) for ROS 2."""
+"""iemd_ros: gyro-aided iEMD visual tracking (Yao & Dani) for ROS 2.
+
+The tracker core is ROS-free: ``from iemd_ros import IemdTracker``.
+"""
+from .tracker import IemdTracker, TrackerConfig, TrackResult
+
+__all__ = ["IemdTracker", "TrackerConfig", "TrackResult"]

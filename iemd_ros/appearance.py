@@ -1,0 +1,118 @@
+"""Appearance sampling: target window -> fixed-size template -> local patches (section 4).
+
+Geometry conventions (0-based image pixels, pixel centres at integer
+coordinates): a window is its centre ``(cx, cy)`` and size ``(w, h)``.
+Template pixel ``u`` (0..T-1) samples image point
+``cx + (u - (T-1)/2) * w/T``.  Patch positions ``c`` are the patch centres
+relative to the window centre in *normalized window units*: the window spans
+[-1, 1] on each axis, so positions, the spatial kernel and the spatial term of
+the ground distance do not depend on the target's size in pixels.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+
+def to_gray(frame: np.ndarray) -> np.ndarray:
+    """Grey levels in [0, 1] (float32) of an HxW or HxWx3 (BGR) uint8 frame."""
+    if frame.ndim == 3:
+        frame = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    return frame.astype(np.float32) * np.float32(1.0 / 255.0)
+
+
+class ImagePyramid:
+    """Gaussian pyramid of one frame, so large windows are sampled without aliasing.
+
+    A window whose template scale (image pixels per template pixel) is s is
+    sampled bilinearly from level ``floor(log2(s))``, where its scale is in
+    [1, 2): every template pixel then integrates at least one pyrDown-smoothed pixel.
+    """
+
+    def __init__(self, gray: np.ndarray, max_levels: int = 4):
+        self.levels = [gray]
+        while len(self.levels) <= max_levels and min(self.levels[-1].shape) >= 32:
+            self.levels.append(cv2.pyrDown(self.levels[-1]))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.levels[0].shape
+
+    def sample(self, center, size, template_size, origin=(0, 0), out_size=None) -> np.ndarray:
+        """Resample a window to template pixels.
+
+        ``template_size`` is (Tw, Th).  By default the whole window is returned as
+        a (Th, Tw) array; ``origin`` (template pixels, may be negative) and
+        ``out_size`` (width, height) select another region of the same template
+        lattice, e.g. patches around the window.  Parts outside the image are
+        padded by replicating the border.
+        """
+        tw, th = template_size
+        out_w, out_h = out_size if out_size is not None else template_size
+        sx, sy = size[0] / tw, size[1] / th
+        level = int(np.clip(np.floor(np.log2(max(min(sx, sy), 1.0))), 0, len(self.levels) - 1))
+        f = 2.0**level
+        # Image point of template pixel u: cx + (u - (Tw-1)/2) * sx; at level l a
+        # full-resolution coordinate x sits at (x + 0.5) / 2^l - 0.5.
+        ox = (center[0] + (origin[0] - (tw - 1) / 2) * sx + 0.5) / f - 0.5
+        oy = (center[1] + (origin[1] - (th - 1) / 2) * sy + 0.5) / f - 0.5
+        warp = np.array([[sx / f, 0.0, ox], [0.0, sy / f, oy]], dtype=np.float64)
+        return cv2.warpAffine(
+            self.levels[level], warp, (int(out_w), int(out_h)),
+            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE,
+        )
+
+
+@dataclass(frozen=True)
+class PatchLayout:
+    """Local patches m x n with step s over a template (paper: 8x8 step 4 on 32x32)."""
+
+    template_size: tuple[int, int]  # (Tw, Th)
+    patch_size: tuple[int, int]  # (m, n) = (width, height)
+    step: int
+
+    def __post_init__(self):
+        tw, th = self.template_size
+        pw, ph = self.patch_size
+        if pw > tw or ph > th or self.step < 1:
+            raise ValueError(f"patches {self.patch_size} step {self.step} do not fit a template {self.template_size}")
+
+    @property
+    def dim(self) -> int:
+        return self.patch_size[0] * self.patch_size[1]
+
+    @property
+    def cells(self) -> tuple[int, int]:
+        """Number of patches per row and column of the template."""
+        tw, th = self.template_size
+        pw, ph = self.patch_size
+        return (tw - pw) // self.step + 1, (th - ph) // self.step + 1
+
+    def cell_positions(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """(N, 2) normalized centres of lattice cells (i, j): patch top-left at (i, j) * step.
+
+        Cells 0..cells-1 are the window's own patches; other integers continue the
+        lattice outside the window.
+        """
+        tw, th = self.template_size
+        pw, ph = self.patch_size
+        x = (np.asarray(i) * self.step + (pw - 1) / 2 - (tw - 1) / 2) / (tw / 2)
+        y = (np.asarray(j) * self.step + (ph - 1) / 2 - (th - 1) / 2) / (th / 2)
+        return np.column_stack([np.ravel(x), np.ravel(y)]).astype(np.float64)
+
+    def positions(self) -> np.ndarray:
+        """(N, 2) normalized centres of the window's patches, row-major like :meth:`extract`."""
+        nx, ny = self.cells
+        gi, gj = np.meshgrid(np.arange(nx), np.arange(ny))
+        return self.cell_positions(gi, gj)
+
+    def extract(self, template: np.ndarray) -> np.ndarray:
+        """(N, m*n) appearance vectors: each patch L2-normalized (the normalized pixels epsilon)."""
+        pw, ph = self.patch_size
+        patches = sliding_window_view(template, (ph, pw))[:: self.step, :: self.step]
+        vectors = patches.reshape(-1, pw * ph).astype(np.float64)
+        norms = np.linalg.norm(vectors, axis=1, keepdims=True)
+        return vectors / np.maximum(norms, 1e-6)

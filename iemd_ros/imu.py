@@ -1,0 +1,260 @@
+"""Time-ordered gyro buffer and frame-interval integration (paper: "Synchronization of the camera and
+the gyroscope in time is required", Section "Gyroscope Data Fusion for Rotation Compensation").
+
+This is the buffer-and-integrate scheme of VIO systems, never an approximate-time synchronizer:
+every gyro sample is kept (bounded memory) in time order and, for frames ``k-1`` and ``k`` with
+camera stamps ``t_{k-1}``, ``t_k``, the rate is integrated over
+``[t_{k-1} + t_d, t_k + t_d]`` (``t_d``: camera-IMU offset, Kalibr's ``t_imu = t_cam + shift``),
+interpolating the rate linearly at both ends.  A frame can be processed once a sample at or past
+``t_k + t_d`` has arrived (:meth:`ImuBuffer.covers`); until then :meth:`ImuBuffer.integrate`
+answers ``not_covered`` so the caller can wait a bounded time and then go on without gyro.
+
+Stamps are integer nanoseconds (like ROS ``builtin_interfaces/Time``).  Real streams are handled:
+samples out of order or with a clock stepping back are put in order; samples with the same stamp
+are merged into their mean (exact repeats collapse); NaN/inf and saturated samples are rejected and
+counted; gaps longer than ``max_gap_ns`` inside an integration window are reported.
+"""
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass
+from enum import Enum
+
+import numpy as np
+
+from .rotation import GyroCalibration, integrate_rates, quat_to_rot, rot_to_quat
+
+__all__ = ["Coverage", "ImuIntegration", "ImuBuffer"]
+
+_MERGE_EVERY = 512
+
+
+class Coverage(str, Enum):
+    """Coverage status of an integration window by the buffered gyro samples."""
+
+    OK = "ok"
+    GAP = "gap"                              # covered, but with a gap > max_gap_ns inside
+    NOT_COVERED = "not_covered"              # no sample at/after the window end yet: wait or go on
+    START_NOT_COVERED = "start_not_covered"  # no sample at/before the window start (startup/dropped)
+    NO_DATA = "no_data"                      # the buffer is empty
+
+
+@dataclass(frozen=True)
+class ImuIntegration:
+    """Result of integrating the gyro over one frame interval.
+
+    ``R`` is the orientation at ``t1`` expressed in the frame at ``t0`` (identity unless covered);
+    ``n_samples`` counts the buffered samples whose values entered the integral (the bracketing
+    ones included); ``max_gap_ns`` is the largest spacing between them.
+    """
+
+    R: np.ndarray
+    q: np.ndarray
+    n_samples: int
+    status: Coverage
+    reason: str
+    t0_ns: int
+    t1_ns: int
+    max_gap_ns: int = 0
+
+    @property
+    def covered(self) -> bool:
+        """True when ``R`` was integrated from data (status ``ok`` or ``gap``)."""
+        return self.status in (Coverage.OK, Coverage.GAP)
+
+    @property
+    def ok(self) -> bool:
+        return self.status is Coverage.OK
+
+
+def _identity(t0, t1, status, reason, n=0, gap=0) -> ImuIntegration:
+    return ImuIntegration(np.eye(3), np.array([1.0, 0.0, 0.0, 0.0]), n, status, reason, t0, t1, gap)
+
+
+def _ms(ns) -> str:
+    return f"{ns / 1e6:.1f} ms"
+
+
+class ImuBuffer:
+    """Bounded, time-ordered gyro buffer with interval integration.
+
+    Parameters
+    ----------
+    max_duration_ns : samples older than ``newest - max_duration_ns`` are dropped.
+    max_samples : hard cap on the number of stored samples (oldest dropped first).
+    saturation : per-axis limit in rad/s on the raw rate; ``|w_i| >= saturation`` rejects a sample
+        (``None``: no limit).
+    max_gap_ns : sample spacing above which an integration window is reported as ``gap``.
+    """
+
+    def __init__(self, max_duration_ns: int = 10_000_000_000, max_samples: int = 20_000,
+                 saturation: float | None = None, max_gap_ns: int = 50_000_000):
+        if int(max_duration_ns) <= 0 or int(max_samples) < 2:
+            raise ValueError(f"need max_duration_ns > 0 and max_samples >= 2, got {max_duration_ns}, {max_samples}")
+        if saturation is not None and not saturation > 0:
+            raise ValueError(f"saturation limit must be > 0 rad/s or None, got {saturation}")
+        if int(max_gap_ns) <= 0:
+            raise ValueError(f"max_gap_ns must be > 0, got {max_gap_ns}")
+        self.max_duration_ns = int(max_duration_ns)
+        self.max_samples = int(max_samples)
+        self.saturation = None if saturation is None else float(saturation)
+        self.max_gap_ns = int(max_gap_ns)
+        self._lock = threading.Lock()
+        self._t = np.zeros(0, dtype=np.int64)
+        self._w = np.zeros((0, 3))
+        self._n = np.zeros(0)                  # number of raw samples merged into each entry
+        self._pend_t: list[np.ndarray] = []
+        self._pend_w: list[np.ndarray] = []
+        self._n_pend = 0
+        self._t_max: int | None = None         # largest stamp ever accepted
+        self._t_integrated: int | None = None  # largest window end integrated so far
+        self.counts = dict(added=0, accepted=0, nan=0, saturated=0, duplicates=0,
+                           out_of_order=0, late=0, dropped=0)
+
+    # ------------------------------------------------------------------ input
+    def add(self, t_ns, w) -> int:
+        """Add one sample (``t_ns`` int, ``w`` (3,)) or many (``t_ns`` (N,), ``w`` (N, 3)).
+
+        ``w`` is the raw rate in rad/s in the IMU frame.  Returns the number of samples accepted.
+        """
+        t = np.atleast_1d(np.asarray(t_ns))
+        w = np.asarray(w, dtype=float)
+        if w.ndim == 1:
+            w = w[None, :]
+        if t.ndim != 1 or w.shape != (len(t), 3):
+            raise ValueError(f"gyro samples need t_ns (N,) and w (N, 3), got shapes {t.shape} and {w.shape}")
+        if not np.issubdtype(t.dtype, np.integer):
+            if not np.all(np.isfinite(t.astype(float))) or np.any(t != np.round(t)):
+                raise ValueError("gyro stamps must be integer nanoseconds")
+        t = t.astype(np.int64)
+        with self._lock:
+            c = self.counts
+            c["added"] += len(t)
+            finite = np.isfinite(w).all(axis=1)
+            c["nan"] += int((~finite).sum())
+            keep = finite
+            if self.saturation is not None:
+                sat = finite & (np.abs(np.where(finite[:, None], w, 0.0)) >= self.saturation).any(axis=1)
+                c["saturated"] += int(sat.sum())
+                keep = keep & ~sat
+            t, w = t[keep], w[keep]
+            if len(t) == 0:
+                return 0
+            # out of order w.r.t. arrival (clock stepping back included)
+            prev_max = np.maximum.accumulate(np.concatenate([[self._t_max if self._t_max is not None else t[0]], t]))[:-1]
+            c["out_of_order"] += int((t < prev_max).sum())
+            if self._t_integrated is not None:
+                c["late"] += int((t < self._t_integrated).sum())
+            self._t_max = int(max(prev_max[-1], t.max()))
+            c["accepted"] += len(t)
+            self._pend_t.append(t)
+            self._pend_w.append(w)
+            self._n_pend += len(t)
+            if self._n_pend >= _MERGE_EVERY:
+                self._merge()
+            return len(t)
+
+    def _merge(self) -> None:
+        """Fold pending samples into the sorted store; merge equal stamps; enforce the memory bound."""
+        if not self._n_pend:
+            return
+        t = np.concatenate([self._t, *self._pend_t])
+        w = np.concatenate([self._w, *self._pend_w])
+        n = np.concatenate([self._n, np.ones(self._n_pend)])
+        self._pend_t, self._pend_w, self._n_pend = [], [], 0
+        order = np.argsort(t, kind="stable")
+        t, w, n = t[order], w[order], n[order]
+        tu, start = np.unique(t, return_index=True)
+        if len(tu) < len(t):
+            self.counts["duplicates"] += len(t) - len(tu)
+            nn = np.add.reduceat(n, start)
+            w = np.add.reduceat(w * n[:, None], start, axis=0) / nn[:, None]
+            t, n = tu, nn
+        keep_from = max(len(t) - self.max_samples, int(np.searchsorted(t, t[-1] - self.max_duration_ns)))
+        self.counts["dropped"] += keep_from
+        self._t, self._w, self._n = t[keep_from:], w[keep_from:], n[keep_from:]
+
+    # ------------------------------------------------------------------ queries
+    def __len__(self) -> int:
+        with self._lock:
+            self._merge()
+            return len(self._t)
+
+    @property
+    def t_newest_ns(self) -> int | None:
+        """Largest stamp ever accepted (None before the first sample)."""
+        return self._t_max
+
+    def covers(self, t_ns: int) -> bool:
+        """True once a sample at or past ``t_ns`` has arrived (a frame at ``t_ns`` can be integrated)."""
+        return self._t_max is not None and self._t_max >= int(t_ns)
+
+    def samples(self, t0_ns: int | None = None, t1_ns: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Copies of the stored (merged, sorted) samples with ``t0_ns <= t <= t1_ns``."""
+        with self._lock:
+            self._merge()
+            lo = 0 if t0_ns is None else int(np.searchsorted(self._t, int(t0_ns), "left"))
+            hi = len(self._t) if t1_ns is None else int(np.searchsorted(self._t, int(t1_ns), "right"))
+            return self._t[lo:hi].copy(), self._w[lo:hi].copy()
+
+    def gaps(self, t0_ns: int | None = None, t1_ns: int | None = None) -> list[tuple[int, int]]:
+        """Pairs ``(t_before, t_after)`` of consecutive stored samples further apart than ``max_gap_ns``."""
+        t, _ = self.samples(t0_ns, t1_ns)
+        i = np.nonzero(np.diff(t) > self.max_gap_ns)[0]
+        return [(int(t[j]), int(t[j + 1])) for j in i]
+
+    def integrate(self, t0_ns: int, t1_ns: int, calibration: GyroCalibration | None = None,
+                  coning: bool = True) -> ImuIntegration:
+        """Integrate the rate over ``[t0_ns, t1_ns]`` (IMU clock) into the rotation of ``t1`` in ``t0``.
+
+        Rates are interpolated linearly at both ends, then integrated exactly
+        (:func:`iemd_ros.rotation.integrate_rates`).  With a ``calibration`` the bias is removed and
+        the rotation is expressed in the camera frame: ``R_cam = R_cam_imu R R_cam_imu^T``.
+        """
+        t0, t1 = int(t0_ns), int(t1_ns)
+        if t1 < t0:
+            raise ValueError(f"integration window ends before it starts: t0={t0} ns, t1={t1} ns")
+        cal = calibration if calibration is not None else GyroCalibration()
+        with self._lock:
+            self._merge()
+            t, w = self._t, self._w
+            if len(t) == 0:
+                return _identity(t0, t1, Coverage.NO_DATA, "no gyro sample received yet")
+            if t[-1] < t1:
+                return _identity(t0, t1, Coverage.NOT_COVERED,
+                                 f"gyro not covering the frame yet: newest sample is {_ms(t1 - t[-1])} "
+                                 f"before the window end")
+            if t[0] > t0:
+                why = ("the oldest buffered sample (older ones were dropped from the bounded buffer)"
+                       if self.counts["dropped"] else "the first gyro sample")
+                return _identity(t0, t1, Coverage.START_NOT_COVERED,
+                                 f"window start is {_ms(t[0] - t0)} before {why}")
+            self._t_integrated = t1 if self._t_integrated is None else max(self._t_integrated, t1)
+            i0 = int(np.searchsorted(t, t0, "right")) - 1   # last sample <= t0
+            i1 = int(np.searchsorted(t, t1, "left"))        # first sample >= t1
+            ts, ws = t[i0:i1 + 1], w[i0:i1 + 1] - cal.bias
+        n_used = len(ts)
+        max_gap = int(np.diff(ts).max()) if n_used > 1 else 0
+        if t1 == t0:
+            return ImuIntegration(np.eye(3), np.array([1.0, 0.0, 0.0, 0.0]), n_used, Coverage.OK,
+                                  "empty window", t0, t1, max_gap)
+        # knots: t0, the samples strictly inside, t1 (rates interpolated at the ends)
+        rel = (ts - t0).astype(float) * 1e-9
+        t_end = (t1 - t0) * 1e-9
+        inner = (rel > 0) & (rel < t_end)
+        knots = np.concatenate([[0.0], rel[inner], [t_end]])
+        wk = np.stack([np.interp(knots, rel, ws[:, j]) for j in range(3)], axis=1)
+        q_imu = integrate_rates(knots, wk, coning=coning)
+        R = cal.R_cam_imu @ quat_to_rot(q_imu) @ cal.R_cam_imu.T
+        q = rot_to_quat(R)
+        if max_gap > self.max_gap_ns:
+            return ImuIntegration(R, q, n_used, Coverage.GAP,
+                                  f"gyro gap of {_ms(max_gap)} (> {_ms(self.max_gap_ns)}) inside the window; "
+                                  "rate interpolated across it", t0, t1, max_gap)
+        return ImuIntegration(R, q, n_used, Coverage.OK, f"{n_used} gyro samples", t0, t1, max_gap)
+
+    def stats(self) -> dict:
+        """Counters (added, accepted, nan, saturated, duplicates, out_of_order, late, dropped) and size."""
+        with self._lock:
+            self._merge()
+            return dict(self.counts, stored=len(self._t))

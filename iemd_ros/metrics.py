@@ -1,0 +1,162 @@
+"""Tracking metrics of the OTB protocol (Wu, Lim & Yang 2013) used in the paper's evaluation.
+
+Boxes are ``(x, y, w, h)`` in 0-based continuous pixel coordinates (top-left corner + size).
+The paper's measure is the relative overlap ``|R_tr ∩ R_gt| / |R_tr ∪ R_gt|`` (Section "Experiments",
+overlap equation); its tables report the average overlap, the gyro experiment also the fraction of
+frames with overlap > 0 and > 40 %.  The OTB success plot / AUC and precision@20px are added so the
+figures compare with the rest of the field.
+
+All fractions are returned in [0, 1]; callers multiply by 100 for percentages.
+
+Conventions (the same as the OTB toolkit's ``calcRectInt`` / ``perfPlot``):
+
+* A box with a NaN coordinate or a non-positive width/height is *invalid*: its IoU with anything is 0
+  and its centre error is ``inf`` (a tracker failure counts as a miss at every threshold).
+* A ground-truth box that is invalid marks an *absent* frame; :func:`score_sequence` excludes such
+  frames (OTB keeps only frames whose four annotation values are > 0 / finite).
+* The success curve counts ``overlap > t`` (strict), the precision counts ``error <= t`` px.
+* The OTB pixel-inclusive convention (``right = x + w - 1``, ``width = right - left + 1``) gives the
+  same intersection as the continuous one used here.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+#: The 21 overlap thresholds of the OTB success plot (0, 0.05, ..., 1).
+OTB_THRESHOLDS = np.linspace(0.0, 1.0, 21)
+#: The OTB precision threshold in pixels.
+PRECISION_THRESHOLD = 20.0
+
+
+def _as_boxes(boxes, name: str) -> np.ndarray:
+    arr = np.asarray(boxes, dtype=float)
+    if arr.ndim == 1:
+        arr = arr[None, :]
+    if arr.ndim != 2 or arr.shape[1] != 4:
+        raise ValueError(f"{name} must be (x, y, w, h) or an (N, 4) array of boxes, got shape {np.shape(boxes)}")
+    return arr
+
+
+def _pair(boxes_a, boxes_b) -> tuple[np.ndarray, np.ndarray]:
+    a = _as_boxes(boxes_a, "boxes_a")
+    b = _as_boxes(boxes_b, "boxes_b")
+    if len(a) != len(b) and len(a) != 1 and len(b) != 1:
+        raise ValueError(f"boxes_a and boxes_b have different lengths: {len(a)} vs {len(b)}")
+    return a, b
+
+
+def valid_boxes(boxes) -> np.ndarray:
+    """Boolean mask of boxes that are finite and have positive width and height."""
+    b = _as_boxes(boxes, "boxes")
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(b).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0)
+
+
+def iou(boxes_a, boxes_b) -> np.ndarray:
+    """Relative overlap ``|A ∩ B| / |A ∪ B|`` of paired boxes (paper's overlap equation), shape (N,).
+
+    A single box broadcasts against N boxes.  Invalid boxes (NaN, w <= 0 or h <= 0) give 0.
+    """
+    a, b = _pair(boxes_a, boxes_b)
+    ok = valid_boxes(a) & valid_boxes(b)
+    with np.errstate(invalid="ignore"):
+        iw = np.minimum(a[:, 0] + a[:, 2], b[:, 0] + b[:, 2]) - np.maximum(a[:, 0], b[:, 0])
+        ih = np.minimum(a[:, 1] + a[:, 3], b[:, 1] + b[:, 3]) - np.maximum(a[:, 1], b[:, 1])
+        inter = np.clip(iw, 0.0, None) * np.clip(ih, 0.0, None)
+        union = a[:, 2] * a[:, 3] + b[:, 2] * b[:, 3] - inter
+        out = np.where(ok, inter / np.where(ok, union, 1.0), 0.0)
+    return out
+
+
+def center_error(boxes_a, boxes_b) -> np.ndarray:
+    """Euclidean distance in pixels between box centres, shape (N,); ``inf`` where a box is invalid."""
+    a, b = _pair(boxes_a, boxes_b)
+    ok = valid_boxes(a) & valid_boxes(b)
+    ca = a[:, :2] + a[:, 2:] / 2.0
+    cb = b[:, :2] + b[:, 2:] / 2.0
+    with np.errstate(invalid="ignore"):
+        d = np.hypot(*(ca - cb).T)
+    return np.where(ok, d, np.inf)
+
+
+def _as_values(values, name: str) -> np.ndarray:
+    arr = np.asarray(values, dtype=float).ravel()
+    if arr.size == 0:
+        raise ValueError(f"{name} is empty: no frames to score")
+    if np.isnan(arr).any():
+        raise ValueError(f"{name} contains NaN (use iou()/center_error(), which map invalid boxes to 0/inf)")
+    return arr
+
+
+def fraction_above(ious, thr: float) -> float:
+    """Fraction of frames whose overlap is strictly greater than ``thr`` (paper: overlap > 0, > 40 %)."""
+    return float(np.mean(_as_values(ious, "ious") > thr))
+
+
+def success_curve(ious, thresholds=OTB_THRESHOLDS) -> np.ndarray:
+    """OTB success plot: for each threshold t, the fraction of frames with overlap > t."""
+    v = _as_values(ious, "ious")
+    t = np.asarray(thresholds, dtype=float).ravel()
+    return (v[None, :] > t[:, None]).mean(axis=1)
+
+
+def success_auc(ious, thresholds=OTB_THRESHOLDS) -> float:
+    """OTB area under the success curve: the mean of the curve over the (21) thresholds."""
+    return float(success_curve(ious, thresholds).mean())
+
+
+def precision_at(center_errors, thr: float = PRECISION_THRESHOLD) -> float:
+    """OTB precision: fraction of frames whose centre error is <= ``thr`` pixels (default 20)."""
+    return float(np.mean(_as_values(center_errors, "center_errors") <= thr))
+
+
+def average_overlap(ious) -> float:
+    """The paper's table metric: mean relative overlap over all (scored) frames."""
+    return float(np.mean(_as_values(ious, "ious")))
+
+
+@dataclass
+class SequenceScores:
+    """All per-sequence figures of one tracker run (fractions in [0, 1]; ``fps`` may be None)."""
+
+    name: str
+    n_frames: int          # frames scored (GT present)
+    n_absent: int          # frames excluded because the GT box is invalid / NaN
+    average_overlap: float
+    success_auc: float
+    precision_20: float
+    overlap_gt_0: float
+    overlap_gt_04: float
+    fps: float | None = None
+    success_curve: list[float] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def score_sequence(pred_boxes, gt_boxes, name: str = "", fps: float | None = None) -> SequenceScores:
+    """Score predicted boxes against ground truth over the frames where the GT box is valid."""
+    pred = _as_boxes(pred_boxes, "pred_boxes")
+    gt = _as_boxes(gt_boxes, "gt_boxes")
+    if len(pred) != len(gt):
+        raise ValueError(f"{name or 'sequence'}: {len(pred)} predicted boxes for {len(gt)} ground-truth boxes")
+    present = valid_boxes(gt)
+    if not present.any():
+        raise ValueError(f"{name or 'sequence'}: no frame has a valid ground-truth box")
+    ov = iou(pred[present], gt[present])
+    ce = center_error(pred[present], gt[present])
+    curve = success_curve(ov)
+    return SequenceScores(
+        name=name,
+        n_frames=int(present.sum()),
+        n_absent=int((~present).sum()),
+        average_overlap=average_overlap(ov),
+        success_auc=float(curve.mean()),
+        precision_20=precision_at(ce, PRECISION_THRESHOLD),
+        overlap_gt_0=fraction_above(ov, 0.0),
+        overlap_gt_04=fraction_above(ov, 0.4),
+        fps=fps,
+        success_curve=[float(c) for c in curve],
+    )

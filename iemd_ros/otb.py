@@ -1,0 +1,176 @@
+"""Loading of OTB-layout sequences (Wu, Lim & Yang 2013), the benchmark of the paper's evaluation.
+
+Layout: ``<root>/<Seq>/img/NNNN.jpg`` and ``<root>/<Seq>/groundtruth_rect.txt``.  GT lines are
+``x, y, w, h`` with 1-based pixel coordinates, separated by commas, tabs or spaces (CRLF and a missing
+final newline occur); blank lines are ignored.  Boxes are returned 0-based (``x - 1, y - 1``).
+
+* Line *i* of the GT belongs to the *i*-th image in frame-number order; frame numbers come from the
+  file names (David starts at 0300, as in the OTB toolkit's ``configSeqs``).
+* A folder with ``groundtruth_rect.<k>.txt`` files (Jogging) holds one target per file; the targets
+  are the sequences ``<Seq>-<k>`` (Jogging-1, Jogging-2), sharing the images.
+* Every image is evaluated (e.g. all 597 frames of Woman).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+import cv2
+import numpy as np
+
+GT_NAME = "groundtruth_rect.txt"
+_MULTI_GT = re.compile(r"^groundtruth_rect\.(\d+)\.txt$")
+_TARGET_NAME = re.compile(r"^(.+)-(\d+)$")
+_SPLIT = re.compile(r"[,\s]+")
+IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
+
+
+@dataclass(frozen=True)
+class Sequence:
+    """One OTB target: its frames (in order) and 0-based ``(x, y, w, h)`` GT boxes, shape (N, 4)."""
+
+    name: str
+    frame_paths: tuple[Path, ...]
+    gt_boxes: np.ndarray
+    frame_numbers: tuple[int, ...] = ()
+
+    def __len__(self) -> int:
+        return len(self.frame_paths)
+
+    def head(self, n: int) -> "Sequence":
+        """The first ``n`` frames (all of them when ``n`` >= len)."""
+        if n < 1:
+            raise ValueError(f"{self.name}: number of frames must be >= 1, got {n}")
+        return Sequence(self.name, self.frame_paths[:n], self.gt_boxes[:n], self.frame_numbers[:n])
+
+    def frames(self) -> Iterator[np.ndarray]:
+        """Yield the frames as BGR uint8 arrays (grayscale JPEGs come back 3-channel)."""
+        for path in self.frame_paths:
+            yield read_frame(path)
+
+
+def read_frame(path: str | Path) -> np.ndarray:
+    """Read one image with OpenCV (BGR uint8, HxWx3); ValueError if it cannot be decoded."""
+    img = cv2.imread(str(path))
+    if img is None:
+        raise ValueError(f"cannot read image {path}")
+    return img
+
+
+def parse_groundtruth(path: str | Path) -> np.ndarray:
+    """Parse an OTB GT file into 0-based ``(x, y, w, h)`` boxes, shape (N, 4) float.
+
+    Each non-empty line is split on ``[,\\s]+`` and must hold exactly four numbers ("NaN" is allowed
+    and marks an absent target).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8", errors="strict")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"cannot read ground truth {path}: {exc}") from None
+    rows = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        line = line.strip()
+        if not line:
+            continue
+        fields = _SPLIT.split(line)
+        try:
+            values = [float(f) for f in fields]
+        except ValueError:
+            raise ValueError(f"{path}:{lineno}: not a number in ground-truth line {line!r}") from None
+        if len(values) != 4:
+            raise ValueError(f"{path}:{lineno}: expected 4 values x,y,w,h, got {len(values)} in {line!r}")
+        rows.append(values)
+    if not rows:
+        raise ValueError(f"{path}: ground-truth file has no boxes")
+    boxes = np.asarray(rows, dtype=float)
+    boxes[:, :2] -= 1.0  # 1-based -> 0-based
+    return boxes
+
+
+def _frames_of(folder: Path) -> tuple[list[Path], list[int]]:
+    img_dir = folder / "img"
+    if not img_dir.is_dir():
+        raise ValueError(f"{folder} is not an OTB sequence: no img/ folder")
+    paths = [p for p in img_dir.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
+    if not paths:
+        raise ValueError(f"{folder} is not an OTB sequence: img/ holds no .jpg/.png images")
+    bad = [p.name for p in paths if not p.stem.isdigit()]
+    if bad:
+        raise ValueError(f"{img_dir}: image names must be frame numbers, got {bad[0]!r}")
+    paths.sort(key=lambda p: int(p.stem))
+    return paths, [int(p.stem) for p in paths]
+
+
+def _gt_files(folder: Path) -> dict[str, Path]:
+    """Target name -> GT file of one sequence folder (Jogging -> Jogging-1, Jogging-2)."""
+    multi = sorted(
+        ((int(m.group(1)), p) for p in folder.glob("groundtruth_rect.*.txt") if (m := _MULTI_GT.match(p.name))),
+    )
+    if multi:
+        return {f"{folder.name}-{k}": p for k, p in multi}
+    single = folder / GT_NAME
+    if single.is_file():
+        return {folder.name: single}
+    return {}
+
+
+def is_sequence_folder(folder: str | Path) -> bool:
+    folder = Path(folder)
+    return (folder / "img").is_dir() and bool(_gt_files(folder))
+
+
+def list_sequences(root: str | Path) -> list[str]:
+    """Names of the OTB targets below ``root``, sorted (Jogging gives Jogging-1 and Jogging-2)."""
+    root = Path(root)
+    if not root.is_dir():
+        raise ValueError(f"OTB root {root} is not a directory")
+    names = []
+    for folder in sorted(p for p in root.iterdir() if p.is_dir()):
+        if is_sequence_folder(folder):
+            names.extend(_gt_files(folder))
+    return names
+
+
+def default_root() -> Path | None:
+    """``../shared/data/otb`` beside the repository (or beside the working directory), if it exists."""
+    here = Path(__file__).resolve().parents[1]
+    for base in (here, Path.cwd()):
+        cand = base.parent / "shared" / "data" / "otb"
+        if cand.is_dir():
+            return cand
+    return None
+
+
+def _resolve(path_or_name: str | Path, root: str | Path | None) -> tuple[Path, str]:
+    """Find the folder and target name for a folder path, ``<folder>-<k>`` or a bare name under root."""
+    p = Path(path_or_name)
+    candidates = [p]
+    if not p.is_absolute() and len(p.parts) == 1:
+        base = Path(root) if root is not None else default_root()
+        if base is not None:
+            candidates.insert(0, base / p)
+    for cand in candidates:
+        if cand.is_dir():
+            return cand, cand.name
+        m = _TARGET_NAME.match(cand.name)
+        if m and (cand.parent / m.group(1)).is_dir():
+            return cand.parent / m.group(1), cand.name
+    raise ValueError(f"OTB sequence {path_or_name!s} not found" + (f" under {root}" if root else ""))
+
+
+def load_sequence(path_or_name: str | Path, root: str | Path | None = None) -> Sequence:
+    """Load one target from a sequence folder, ``<folder>-<k>`` (multi-target) or a name under ``root``."""
+    folder, name = _resolve(path_or_name, root)
+    paths, numbers = _frames_of(folder)
+    gts = _gt_files(folder)
+    if not gts:
+        raise ValueError(f"{folder} is not an OTB sequence: no {GT_NAME} (or groundtruth_rect.<k>.txt)")
+    if name not in gts:
+        raise ValueError(f"{folder} holds the targets {', '.join(gts)}; choose one of them, not {name!r}")
+    boxes = parse_groundtruth(gts[name])
+    if len(boxes) != len(paths):
+        raise ValueError(f"{gts[name]}: {len(boxes)} ground-truth boxes for {len(paths)} images in {folder / 'img'}")
+    return Sequence(name, tuple(paths), boxes, tuple(numbers))

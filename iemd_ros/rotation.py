@@ -1,0 +1,236 @@
+"""Rotation from gyroscope rates (paper, "Gyroscope Data Fusion for Rotation Compensation").
+
+Conventions
+-----------
+* Quaternions are Hamilton, scalar first: ``q = m + a i + b j + c k`` stored as ``[m, a, b, c]``,
+  exactly the paper's notation of eq. 22.
+* Rates are *body* rates: ``dR/dt = R [w]x``, so ``R(t)`` is the orientation of the sensor at time t
+  expressed in the sensor frame at the start of the interval.  Composition is by right
+  multiplication, ``R = exp([w1 dt1]x) exp([w2 dt2]x) ...``, which is also what the paper's
+  ``Omega(w) q`` (eq. 21) means: ``Omega(w) q == q * (0, w)``.
+* ``R_cam_imu`` maps IMU-frame vectors into the camera frame (``w_cam = R_cam_imu w_imu``); the
+  gyro bias is in the IMU frame and subtracted before rotating.
+
+The exact integrator treats the rate as piecewise linear between samples (the samples are its knots)
+and integrates each sub-interval with the exact SO(3) exponential of the 4th-order Magnus term
+``h (w0 + w1) / 2 + h^2 / 12 (w0 x w1)`` (trapezoid rate plus the coning correction); the
+paper's first-order step is :func:`integrate_first_order`, kept for comparison.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "skew", "quat_mul", "quat_normalize", "quat_to_rot", "rot_to_quat", "quat_exp", "so3_exp",
+    "rotation_angle", "omega_matrix", "integrate_rates", "integrate_first_order",
+    "GyroCalibration", "StillBiasEstimator",
+]
+
+
+def skew(w) -> np.ndarray:
+    """``[w]x``: the 3x3 cross-product matrix of ``w`` (also (N,3) -> (N,3,3))."""
+    w = np.asarray(w, dtype=float)
+    out = np.zeros(w.shape[:-1] + (3, 3))
+    out[..., 0, 1], out[..., 0, 2] = -w[..., 2], w[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = w[..., 2], -w[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -w[..., 1], w[..., 0]
+    return out
+
+
+def quat_mul(p, q) -> np.ndarray:
+    """Hamilton product ``p * q`` of scalar-first quaternions (broadcasts over leading axes)."""
+    p = np.asarray(p, dtype=float)
+    q = np.asarray(q, dtype=float)
+    pw, px, py, pz = np.moveaxis(p, -1, 0)
+    qw, qx, qy, qz = np.moveaxis(q, -1, 0)
+    return np.stack([
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    ], axis=-1)
+
+
+def quat_normalize(q) -> np.ndarray:
+    """Unit quaternion with a non-negative scalar part (``q`` and ``-q`` are the same rotation)."""
+    q = np.asarray(q, dtype=float)
+    n = np.linalg.norm(q, axis=-1, keepdims=True)
+    if np.any(n == 0) or not np.all(np.isfinite(n)):
+        raise ValueError("cannot normalize a zero or non-finite quaternion")
+    q = q / n
+    return np.where(q[..., :1] < 0, -q, q)
+
+
+def quat_to_rot(q) -> np.ndarray:
+    """Rotation matrix of a unit quaternion ``[m, a, b, c]`` (paper eq. 22)."""
+    m, a, b, c = np.moveaxis(quat_normalize(q), -1, 0)
+    return np.stack([
+        np.stack([1 - 2 * b * b - 2 * c * c, 2 * a * b - 2 * c * m, 2 * a * c + 2 * b * m], -1),
+        np.stack([2 * a * b + 2 * c * m, 1 - 2 * a * a - 2 * c * c, 2 * b * c - 2 * a * m], -1),
+        np.stack([2 * a * c - 2 * b * m, 2 * b * c + 2 * a * m, 1 - 2 * a * a - 2 * b * b], -1),
+    ], axis=-2)
+
+
+def rot_to_quat(R) -> np.ndarray:
+    """Unit quaternion of a rotation matrix (Shepperd's method, robust for all angles)."""
+    R = np.asarray(R, dtype=float)
+    if R.shape[-2:] != (3, 3):
+        raise ValueError(f"rotation matrices must be (..., 3, 3), got shape {R.shape}")
+    tr = np.trace(R, axis1=-2, axis2=-1)
+    cands = np.stack([
+        np.stack([1 + tr, R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]], -1),
+        np.stack([R[..., 2, 1] - R[..., 1, 2], 1 + 2 * R[..., 0, 0] - tr, R[..., 0, 1] + R[..., 1, 0], R[..., 0, 2] + R[..., 2, 0]], -1),
+        np.stack([R[..., 0, 2] - R[..., 2, 0], R[..., 0, 1] + R[..., 1, 0], 1 + 2 * R[..., 1, 1] - tr, R[..., 1, 2] + R[..., 2, 1]], -1),
+        np.stack([R[..., 1, 0] - R[..., 0, 1], R[..., 0, 2] + R[..., 2, 0], R[..., 1, 2] + R[..., 2, 1], 1 + 2 * R[..., 2, 2] - tr], -1),
+    ], axis=-2)
+    diag = np.stack([tr, R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]], -1)
+    best = np.argmax(diag, axis=-1)
+    q = np.take_along_axis(cands, best[..., None, None], axis=-2)[..., 0, :]
+    return quat_normalize(q)
+
+
+def quat_exp(phi) -> np.ndarray:
+    """Unit quaternion of the rotation vector ``phi`` (exact exponential map), (..., 3) -> (..., 4)."""
+    phi = np.asarray(phi, dtype=float)
+    theta = np.linalg.norm(phi, axis=-1, keepdims=True)
+    half = 0.5 * theta
+    # sin(theta/2)/theta, with its Taylor series near 0
+    small = theta < 1e-6
+    k = np.where(small, 0.5 - theta ** 2 / 48.0, np.sin(half) / np.where(small, 1.0, theta))
+    return np.concatenate([np.cos(half), k * phi], axis=-1)
+
+
+def so3_exp(phi) -> np.ndarray:
+    """Rotation matrix ``exp([phi]x)`` (Rodrigues), (..., 3) -> (..., 3, 3)."""
+    return quat_to_rot(quat_exp(phi))
+
+
+def rotation_angle(R) -> np.ndarray:
+    """Angle of a rotation matrix in radians (numerically safe for small and large angles)."""
+    q = rot_to_quat(R)
+    return 2.0 * np.arctan2(np.linalg.norm(q[..., 1:], axis=-1), np.abs(q[..., 0]))
+
+
+def omega_matrix(w) -> np.ndarray:
+    """The paper's 4x4 ``Omega(w) = [[0, -w^T], [w, -[w]x]]`` (eq. 21), with ``Omega(w) q = q * (0, w)``."""
+    w = np.asarray(w, dtype=float)
+    out = np.zeros(w.shape[:-1] + (4, 4))
+    out[..., 0, 1:] = -w
+    out[..., 1:, 0] = w
+    out[..., 1:, 1:] = -skew(w)
+    return out
+
+
+def _chain(q_steps: np.ndarray) -> np.ndarray:
+    """Ordered product ``q_1 * q_2 * ... * q_n`` by pairwise (tree) reduction, renormalized."""
+    q = q_steps
+    if len(q) == 0:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    while len(q) > 1:
+        if len(q) % 2:
+            q = np.concatenate([q, [[1.0, 0.0, 0.0, 0.0]]])
+        q = quat_normalize(quat_mul(q[0::2], q[1::2]))
+    return q[0]
+
+
+def integrate_rates(t, w, coning: bool = True) -> np.ndarray:
+    """Exact integration of a piecewise-linear body rate through knots ``(t_i, w_i)``.
+
+    Returns the unit quaternion of ``R = prod_i exp(phi_i)`` (right-multiplied, so ``R`` is the
+    orientation at ``t[-1]`` in the frame at ``t[0]``), with
+    ``phi_i = h_i (w_i + w_{i+1}) / 2 + coning * h_i^2 / 12 (w_i x w_{i+1})`` (4th-order Magnus
+    for a linear rate).  ``t`` in seconds (any origin), strictly increasing; ``w`` (N, 3) rad/s.
+    """
+    t = np.asarray(t, dtype=float)
+    w = np.asarray(w, dtype=float)
+    if t.ndim != 1 or w.shape != (len(t), 3):
+        raise ValueError(f"need t of shape (N,) and w of shape (N, 3), got {t.shape} and {w.shape}")
+    if len(t) < 2:
+        return np.array([1.0, 0.0, 0.0, 0.0])
+    h = np.diff(t)
+    if np.any(h <= 0):
+        raise ValueError("knot times must be strictly increasing")
+    phi = 0.5 * h[:, None] * (w[:-1] + w[1:])
+    if coning:
+        phi = phi + (h ** 2 / 12.0)[:, None] * np.cross(w[:-1], w[1:])
+    return _chain(quat_exp(phi))
+
+
+def integrate_first_order(t, w) -> np.ndarray:
+    """The paper's step ``q(k+1) = q(k) + 1/2 Omega(w_k) q(k) dt`` (eq. 21), renormalized each step.
+
+    Forward Euler with the rate held at each sample over ``[t_k, t_{k+1})`` (as a sampled gyro is
+    used in the paper's Algorithm 2).  Returns the final unit quaternion.
+    """
+    t = np.asarray(t, dtype=float)
+    w = np.asarray(w, dtype=float)
+    if t.ndim != 1 or w.shape != (len(t), 3):
+        raise ValueError(f"need t of shape (N,) and w of shape (N, 3), got {t.shape} and {w.shape}")
+    q = np.array([1.0, 0.0, 0.0, 0.0])
+    for dt, om in zip(np.diff(t), omega_matrix(w[:-1])):
+        q = quat_normalize(q + 0.5 * (om @ q) * dt)
+    return q
+
+
+@dataclass(frozen=True)
+class GyroCalibration:
+    """IMU->camera rotation and gyro bias: ``w_cam = R_cam_imu (w_imu - bias)``."""
+
+    R_cam_imu: np.ndarray = None  # type: ignore[assignment]
+    bias: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self):
+        R = np.eye(3) if self.R_cam_imu is None else np.asarray(self.R_cam_imu, dtype=float)
+        b = np.zeros(3) if self.bias is None else np.asarray(self.bias, dtype=float)
+        if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
+            raise ValueError(f"R_cam_imu must be a proper 3x3 rotation matrix, got {R.tolist()}")
+        if b.shape != (3,) or not np.all(np.isfinite(b)):
+            raise ValueError(f"gyro bias must be 3 finite values (rad/s), got {b.tolist()}")
+        object.__setattr__(self, "R_cam_imu", R)
+        object.__setattr__(self, "bias", b)
+
+    def to_camera(self, w_imu) -> np.ndarray:
+        """Camera-frame rates of (N, 3) IMU-frame rates."""
+        return (np.asarray(w_imu, dtype=float) - self.bias) @ self.R_cam_imu.T
+
+
+class StillBiasEstimator:
+    """Gyro bias from a still start: the mean of the first ``n`` samples if their spread is small.
+
+    The spread is the largest per-axis standard deviation; above ``max_std`` (rad/s) the start is
+    not still and no estimate is made (``status`` says why).  ``n == 0`` disables it.
+    """
+
+    def __init__(self, n: int = 0, max_std: float = 0.02):
+        if n < 0 or (n == 1):
+            raise ValueError(f"still-bias sample count must be 0 (off) or >= 2, got {n}")
+        if not max_std > 0:
+            raise ValueError(f"still-bias max_std must be > 0 rad/s, got {max_std}")
+        self.n, self.max_std = int(n), float(max_std)
+        self._buf: list[np.ndarray] = []
+        self.bias: np.ndarray | None = None
+        self.done = self.n == 0
+        self.status = "off" if self.n == 0 else f"collecting 0/{self.n} samples"
+
+    def update(self, w) -> bool:
+        """Feed (3,) or (N, 3) finite IMU-frame rates; returns True once an estimate exists."""
+        if self.done:
+            return self.bias is not None
+        self._buf.append(np.atleast_2d(np.asarray(w, dtype=float)))
+        got = sum(len(b) for b in self._buf)
+        if got < self.n:
+            self.status = f"collecting {got}/{self.n} samples"
+            return False
+        first = np.concatenate(self._buf)[: self.n]
+        self._buf = []
+        self.done = True
+        spread = float(first.std(axis=0).max())
+        if spread > self.max_std:
+            self.status = (f"start not still: spread {spread:.4f} rad/s > {self.max_std:.4f}; "
+                           "keeping the configured bias")
+            return False
+        self.bias = first.mean(axis=0)
+        self.status = f"estimated from {self.n} still samples (spread {spread:.4f} rad/s)"
+        return True
