@@ -73,6 +73,8 @@ class PatchLayout:
     template_size: tuple[int, int]  # (Tw, Th)
     patch_size: tuple[int, int]  # (m, n) = (width, height)
     step: int
+    zero_mean: bool = True  # remove each patch's mean grey level before normalizing
+    min_contrast: float = 0.02  # grey-level std below which a patch counts as flat
 
     def __post_init__(self):
         tw, th = self.template_size
@@ -110,9 +112,24 @@ class PatchLayout:
         return self.cell_positions(gi, gj)
 
     def extract(self, template: np.ndarray) -> np.ndarray:
-        """(N, m*n) appearance vectors: each patch L2-normalized (the normalized pixels epsilon)."""
+        """(N, m*n) appearance vectors epsilon ("normalized pixel values").
+
+        Normalization choice: with ``zero_mean`` each patch loses its mean grey
+        level and is scaled to unit L2 norm, so epsilon is invariant to local
+        brightness and contrast; a patch whose standard deviation is below
+        ``min_contrast`` is scaled as if it had that contrast (its vector is
+        shorter than 1, it codes weakly and matches other flat patches).  Plain
+        L2 normalization of raw grey levels (``zero_mean=False``) leaves every
+        patch inside a narrow cone of positive vectors: appearance distances
+        and code weights then barely separate target from background.
+        """
         pw, ph = self.patch_size
         patches = sliding_window_view(template, (ph, pw))[:: self.step, :: self.step]
         vectors = patches.reshape(-1, pw * ph).astype(np.float64)
+        if self.zero_mean:
+            vectors -= vectors.mean(axis=1, keepdims=True)
+            floor = self.min_contrast * np.sqrt(pw * ph)
+        else:
+            floor = 1e-6
         norms = np.linalg.norm(vectors, axis=1, keepdims=True)
-        return vectors / np.maximum(norms, 1e-6)
+        return vectors / np.maximum(norms, floor)

@@ -22,7 +22,8 @@ class CandidateLattice:
     """Patches of one frame around an anchor window, coded on demand."""
 
     def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, anchor_center, size,
-                 coder: SparseCoder, n_templates: int, target_eps: np.ndarray, alpha: float):
+                 coder: SparseCoder, n_templates: int, target_eps: np.ndarray, alpha: float,
+                 target_codes: np.ndarray):
         self.pyramid = pyramid
         self.layout = layout
         self.center = np.asarray(anchor_center, dtype=np.float64)
@@ -31,6 +32,7 @@ class CandidateLattice:
         self.n_templates = n_templates
         self.target_eps = target_eps
         self.alpha = alpha
+        self.target_codes = target_codes  # warm starts: codes of the target patch at the same cell
         self._index: dict[tuple[int, int], int] = {}
         self.pos = np.zeros((0, 2))
         self.code_weights = np.zeros(0)
@@ -60,7 +62,9 @@ class CandidateLattice:
         n_cols = mi.max() - a0 + 1
         eps_all = self.layout.extract(region)
         eps = eps_all[(mj - b0) * n_cols + (mi - a0)]
-        codes = self.coder.encode(eps.T)
+        nx, ny = self.layout.cells
+        nearest = np.clip(mj, 0, ny - 1) * nx + np.clip(mi, 0, nx - 1)
+        codes = self.coder.encode(eps.T, warm=self.target_codes[:, nearest])
         start = len(self.pos)
         for k, cell in enumerate(missing):
             self._index[cell] = start + k

@@ -180,9 +180,11 @@ class GyroConfig:
 class GyroPrediction:
     """Prediction for frame k from frame k-1.
 
-    ``R``: camera k in camera k-1; ``H``: ``K R^T K^-1`` (undistorted OpenCV pixels); ``prior``: 3x3
-    for ``tracker.update(frame, prior=...)`` (raw pixels; local fit at ``box`` with distortion); ``box``: lens-aware predicted box.  All None when no gyro prediction is available,
-    with ``reason`` saying why.
+    ``R``: camera k in camera k-1; ``H``: ``K R^T K^-1`` (undistorted pixels); ``prior``: the 3x3
+    for ``tracker.update(frame, prior=...)`` (raw pixels; fitted locally at ``box`` when the lens
+    distorts); ``box``: the lens-aware predicted box.  ``R``/``H`` are None when the gyro gives no
+    rotation, ``prior``/``box`` also when no box was given or it lies outside the lens model;
+    ``reason`` says why.
     """
 
     integration: ImuIntegration
@@ -230,9 +232,7 @@ class GyroPredictor:
         n = self.buffer.add(t_ns, w)
         if not self.bias_estimator.done:
             w2 = np.atleast_2d(np.asarray(w, dtype=float))
-            good = np.isfinite(w2).all(axis=1)
-            if self.config.saturation is not None:
-                good &= (np.abs(np.where(good[:, None], w2, 0)) < self.config.saturation).all(axis=1)
+            good = self.buffer.accepted(w2)
             if good.any() and self.bias_estimator.update(w2[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
         return n
@@ -263,6 +263,9 @@ class GyroPredictor:
         H = rotation_homography(self.camera.K, integ.R)
         if box is None:
             return GyroPrediction(integ, integ.R, H, H, None, integ.reason)
-        prior, res = local_prior(box, H, self.camera)
-        pbox = predict_box(box, H, self.camera)
+        try:
+            prior, res = local_prior(box, H, self.camera)
+            pbox = predict_box(box, H, self.camera)
+        except ValueError as exc:       # box far outside the lens model's valid region
+            return GyroPrediction(integ, integ.R, H, None, None, f"no gyro prior at this box: {exc}")
         return GyroPrediction(integ, integ.R, H, prior, pbox, integ.reason, res)

@@ -127,16 +127,12 @@ class ImuBuffer:
             if not np.all(np.isfinite(t.astype(float))) or np.any(t != np.round(t)):
                 raise ValueError("gyro stamps must be integer nanoseconds")
         t = t.astype(np.int64)
+        finite, keep = self._screen(w)
         with self._lock:
             c = self.counts
             c["added"] += len(t)
-            finite = np.isfinite(w).all(axis=1)
             c["nan"] += int((~finite).sum())
-            keep = finite
-            if self.saturation is not None:
-                sat = finite & (np.abs(np.where(finite[:, None], w, 0.0)) >= self.saturation).any(axis=1)
-                c["saturated"] += int(sat.sum())
-                keep = keep & ~sat
+            c["saturated"] += int((finite & ~keep).sum())
             t, w = t[keep], w[keep]
             if len(t) == 0:
                 return 0
@@ -153,6 +149,18 @@ class ImuBuffer:
             if self._n_pend >= _MERGE_EVERY:
                 self._merge()
             return len(t)
+
+    def _screen(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(finite, accepted) masks of (N, 3) rates: NaN/inf rejected, then ``|w_i| >= saturation``."""
+        finite = np.isfinite(w).all(axis=1)
+        keep = finite.copy()
+        if self.saturation is not None:
+            keep &= (np.abs(np.where(finite[:, None], w, 0.0)) < self.saturation).all(axis=1)
+        return finite, keep
+
+    def accepted(self, w) -> np.ndarray:
+        """Boolean mask of the (N, 3) rates this buffer accepts (finite and not saturated)."""
+        return self._screen(np.atleast_2d(np.asarray(w, dtype=float)))[1]
 
     def _merge(self) -> None:
         """Fold pending samples into the sorted store; merge equal stamps; enforce the memory bound."""

@@ -49,12 +49,34 @@ def _cholesky_solve(m, rhs, out, k):
 
 
 @numba.njit(cache=True)
-def _active_set_lasso(gram, correlations, lam, tol, ridge):
+def _solve_active(gram, b, active, idx, sub, rhs, z, ridge):
+    """z = G_PP^-1 b_P on the active set P (listed in idx[:k]); returns k."""
+    k = 0
+    for j in range(active.size):
+        if active[j]:
+            idx[k] = j
+            k += 1
+    for r in range(k):
+        rhs[r] = b[idx[r]]
+        for c in range(k):
+            sub[r, c] = gram[idx[r], idx[c]]
+        sub[r, r] += ridge
+    _cholesky_solve(sub, rhs, z, k)
+    return k
+
+
+@numba.njit(cache=True)
+def _active_set_lasso(gram, correlations, lam, tol, ridge, warm):
     """Exact non-negative lasso for every column of ``correlations`` (= Phi' E).
 
-    ``ridge`` (1e-10) keeps the active sub-system solvable when two atoms are
-    identical (e.g. replicated border padding in two templates); it changes the
-    KKT residual by ridge * |a|, far below any tolerance that matters.
+    Lawson-Hanson active set on the quadratic program a'Ga - 2(b - lambda/2)'a.
+    ``warm`` (n_atoms, n_signals) bool is a guess of each support (e.g. the
+    codes of a nearly identical patch); it is pruned to a feasible start and
+    then the method runs as usual, so the result is the same exact solution,
+    reached in fewer steps.  ``ridge`` (1e-10) keeps the active sub-system
+    solvable when two atoms are identical (e.g. replicated border padding in two
+    templates); it changes the KKT residual by ridge * |a|, far below any
+    tolerance that matters.
     """
     n_atoms, n_signals = correlations.shape
     codes = np.zeros((n_atoms, n_signals))
@@ -64,12 +86,31 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
     sub = np.empty((n_atoms, n_atoms))
     rhs = np.empty(n_atoms)
     z = np.empty(n_atoms)
+    a = np.empty(n_atoms)
+    w = np.empty(n_atoms)  # half the negative gradient of the objective at a
     for n in range(n_signals):
         b = correlations[:, n] - half_lam
-        a = np.zeros(n_atoms)
-        active[:] = False
-        w = b.copy()  # half the negative gradient of the objective at a
+        a[:] = 0.0
+        active[:] = warm[:, n]
+        # Prune the warm support until its unconstrained solution is positive.
+        while True:
+            k = _solve_active(gram, b, active, idx, sub, rhs, z, ridge)
+            if k == 0:
+                break
+            positive = True
+            for r in range(k):
+                if z[r] <= 0.0:
+                    active[idx[r]] = False
+                    positive = False
+            if positive:
+                for r in range(k):
+                    a[idx[r]] = z[r]
+                break
         for _ in range(3 * n_atoms):
+            w[:] = b
+            for r in range(n_atoms):
+                if a[r] != 0.0:
+                    w -= gram[:, r] * a[r]
             j_best = -1
             w_best = tol
             for j in range(n_atoms):
@@ -80,17 +121,7 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
                 break
             active[j_best] = True
             while True:
-                k = 0
-                for j in range(n_atoms):
-                    if active[j]:
-                        idx[k] = j
-                        k += 1
-                for r in range(k):
-                    rhs[r] = b[idx[r]]
-                    for c in range(k):
-                        sub[r, c] = gram[idx[r], idx[c]]
-                    sub[r, r] += ridge
-                _cholesky_solve(sub, rhs, z, k)
+                k = _solve_active(gram, b, active, idx, sub, rhs, z, ridge)
                 feasible = True
                 for r in range(k):
                     if z[r] <= 0.0:
@@ -113,11 +144,6 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
                     if a[j] <= 1e-14:
                         a[j] = 0.0
                         active[j] = False
-            # w = b - G a, using only the active columns (codes are sparse).
-            w[:] = b
-            for r in range(n_atoms):
-                if a[r] != 0.0:
-                    w -= gram[:, r] * a[r]
         codes[:, n] = a
     return codes
 
@@ -136,10 +162,20 @@ class SparseCoder:
         self.lam = float(lam)
         self.tol = float(tol)
 
-    def encode(self, signals: np.ndarray) -> np.ndarray:
-        """Codes (n_atoms, n_signals) of the columns of ``signals`` (dim, n_signals)."""
-        correlations = self.dictionary.T @ np.asarray(signals, dtype=np.float64)
-        return _active_set_lasso(self.gram, np.ascontiguousarray(correlations), self.lam, self.tol, 1e-10)
+    def encode(self, signals: np.ndarray, warm: np.ndarray | None = None) -> np.ndarray:
+        """Codes (n_atoms, n_signals) of the columns of ``signals`` (dim, n_signals).
+
+        ``warm``: optional codes (n_atoms, n_signals) of similar signals whose
+        supports start the active set; the solution is the same, only faster.
+        """
+        correlations = np.ascontiguousarray(self.dictionary.T @ np.asarray(signals, dtype=np.float64))
+        if warm is None:
+            support = np.zeros(correlations.shape, dtype=np.bool_)
+        else:
+            if warm.shape != correlations.shape:
+                raise ValueError(f"warm codes {warm.shape} do not match {correlations.shape}")
+            support = np.ascontiguousarray(warm > 0)
+        return _active_set_lasso(self.gram, correlations, self.lam, self.tol, 1e-10, support)
 
 
 def lasso_objective(dictionary, signals, codes, lam):

@@ -31,6 +31,7 @@ class TrackerConfig:
     template_size: tuple[int, int] = (32, 32)  # (width, height) of the resampled window
     patch_size: tuple[int, int] = (8, 8)  # local patch m x n
     patch_step: int = 4
+    zero_mean_patches: bool = True  # appearance vectors: zero-mean, unit norm (see PatchLayout.extract)
     n_templates: int = 3  # L, templates in the dictionary
     lam: float = 0.01  # lambda of eq. (lagrange)
     alpha: float = 0.5  # appearance vs spatial weight of the ground distance
@@ -106,6 +107,7 @@ class _Target:
     eps: np.ndarray  # (N_T, dim) appearance vectors
     pos: np.ndarray  # (N_T, 2) normalized positions
     weights: np.ndarray  # w_T (N_T,)
+    codes: np.ndarray  # sparse codes against the current dictionary (n_atoms, N_T)
 
 
 @dataclass
@@ -126,7 +128,7 @@ class IemdTracker:
         if not isinstance(self.config, TrackerConfig):
             raise ValueError("config must be a TrackerConfig")
         cfg = self.config
-        self.layout = PatchLayout(cfg.template_size, cfg.patch_size, cfg.patch_step)
+        self.layout = PatchLayout(cfg.template_size, cfg.patch_size, cfg.patch_step, cfg.zero_mean_patches)
         self._center = None
         self._size = None
         self._recent_emd: deque[float] = deque(maxlen=30)
@@ -147,7 +149,7 @@ class IemdTracker:
                                              cfg.forgetting, cfg.reconstruction_lambda)
         self.dictionary.add(template, 0.0, 0)
         eps = self.layout.extract(template)
-        self._target = _Target(eps=eps, pos=self.layout.positions(), weights=np.zeros(len(eps)))
+        self._target = _Target(eps=eps, pos=self.layout.positions(), weights=np.zeros(len(eps)), codes=np.zeros(0))
         self._refresh_target_weights()
         self._recent_emd.clear()
         self._frame_index = 0
@@ -167,7 +169,8 @@ class IemdTracker:
         pyramid = ImagePyramid(to_gray(frame))
 
         lattice = CandidateLattice(pyramid, self.layout, center, size, self.dictionary.coder,
-                                   len(self.dictionary.templates), self._target.eps, cfg.alpha)
+                                   len(self.dictionary.templates), self._target.eps, cfg.alpha,
+                                   self._target.codes)
         best = self._descend(lattice, np.zeros(2))
         starts = 1
         baseline = self._baseline()
@@ -212,6 +215,7 @@ class IemdTracker:
 
     def _refresh_target_weights(self) -> None:
         codes = self.dictionary.coder.encode(self._target.eps.T)
+        self._target.codes = codes
         pooled = max_alignment_pooling(codes, len(self.dictionary.templates))
         self._target.weights = target_weights(pooled, self._target.pos, self.config.kernel_bandwidth)
 
@@ -262,10 +266,12 @@ class IemdTracker:
         if cfg.scale_step == 0:
             return 1.0, emd_at_scale_one, 0
         best_emd, best_scale, codings = np.inf, 1.0, 0
+        warm = self._target.codes  # the variants have the target's layout; then each other's
         for scale in (1.0, 1.0 - cfg.scale_step, 1.0 + cfg.scale_step):
             template = pyramid.sample(center, size * scale, cfg.template_size)
             eps = self.layout.extract(template)
-            codes = self.dictionary.coder.encode(eps.T)
+            codes = self.dictionary.coder.encode(eps.T, warm=warm)
+            warm = codes if scale == 1.0 else warm
             codings += len(eps)
             pooled = max_alignment_pooling(codes, len(self.dictionary.templates))
             if not pooled.any():
