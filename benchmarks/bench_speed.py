@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""Speed of iEMD against OpenCV CSRT (and KCF) on the same frames, measured in the same run.
+
+For each sequence the first ``--frames`` frames are decoded into memory once, then every tracker runs on
+them back to back (interleaved per sequence, so load changes on the shared machine hit all trackers
+alike).  Only ``update`` calls are timed.  A tracker that has lost the target may run faster (OpenCV
+skips its model update on a failed frame), so the number of frames each tracker reported failed is shown.  Prints median / p95 update time (ms) and fps per tracker, and
+the fps ratio of each tracker against the reference (CSRT by default) per sequence and pooled.
+
+Sequences: a few OTB sequences (init on their first GT box) plus the 640x480 CMU desk frames
+(``../shared/data/imu/cmu_hwangbo_desk``, init on the first box of ``gt_eagle_head.txt``).
+
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_speed.py [--trackers iemd,csrt] [--frames 150]
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from iemd_ros.evaluation import TRACKERS, make_tracker, run_tracker
+from iemd_ros.otb import default_root, list_sequences, load_sequence, read_frame
+
+DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
+
+
+def desk_sequence(n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
+    """First ``n`` CMU desk frames (640x480) and the 0-based first eagle-head GT box."""
+    paths = sorted((DESK / "desk_img").glob("*.jpg"))[:n]
+    first = (DESK / "gt_eagle_head.txt").read_text().splitlines()[0].split(",")[:4]
+    box = np.asarray([float(v) for v in first]) - np.array([1.0, 1.0, 0.0, 0.0])  # 1-based -> 0-based
+    return "desk-640x480", [read_frame(p) for p in paths], box
+
+
+def otb_sequence(name: str, root: Path, n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
+    seq = load_sequence(name, root).head(n)
+    shape = "x".join(map(str, read_frame(seq.frame_paths[0]).shape[1::-1]))
+    return f"{name}-{shape}", list(seq.frames()), seq.gt_boxes[0]
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.error = lambda msg: (print(f"bench_speed: error: {msg}", file=sys.stderr), sys.exit(2))  # one line
+    p.add_argument("--trackers", default="iemd,csrt", help=f"comma-separated from {','.join(TRACKERS)}")
+    p.add_argument("--reference", default="csrt", help="tracker the fps ratios are taken against")
+    p.add_argument("--sequences", default="Car4,Bolt2,Woman,DragonBaby", help="OTB sequences")
+    p.add_argument("--frames", type=int, default=150)
+    p.add_argument("--no-desk", action="store_true", help="skip the 640x480 CMU desk frames")
+    p.add_argument("--cv-threads", type=int, default=None,
+                   help="cv2.setNumThreads(N) before timing (default: OpenCV's own choice)")
+    args = p.parse_args(argv)
+    trackers = [t.strip() for t in args.trackers.split(",") if t.strip()]
+    try:
+        if args.frames < 2:
+            raise ValueError(f"--frames must be >= 2, got {args.frames}")
+        for t in trackers:
+            make_tracker(t)
+        if args.reference not in trackers:
+            raise ValueError(f"--reference {args.reference!r} is not among --trackers {trackers}")
+        root = default_root()
+        if root is None:
+            raise ValueError("../shared/data/otb not found")
+        names = [n for n in args.sequences.split(",") if n]
+        unknown = sorted(set(names) - set(list_sequences(root)))
+        if unknown:
+            raise ValueError(f"unknown OTB sequence(s) {', '.join(unknown)} in {root}")
+        loaders = [lambda n=n: otb_sequence(n, root, args.frames) for n in names]
+        if not args.no_desk and DESK.is_dir():
+            loaders.append(lambda: desk_sequence(args.frames))
+    except ValueError as exc:
+        print(f"bench_speed: error: {exc}", file=sys.stderr)
+        return 2
+
+    if args.cv_threads is not None:
+        cv2.setNumThreads(args.cv_threads)
+    pooled: dict[str, list[np.ndarray]] = {t: [] for t in trackers}
+    failed: dict[str, int] = {t: 0 for t in trackers}
+    print(f"OpenCV {cv2.__version__}, cv2.getNumThreads() = {cv2.getNumThreads()}; {args.frames} frames/sequence")
+    print(f"{'sequence':<22} {'tracker':<6} {'median ms':>10} {'p95 ms':>8} {'fps':>8} {'ratio':>7} {'failed':>7}")
+    for load in loaders:
+        name, frames, box = load()
+        ms, fails = {}, {}
+        for t in trackers:
+            run = run_tracker(make_tracker(t), frames, box)
+            ms[t], fails[t] = 1e3 * run.update_seconds, int((~run.ok).sum())
+            pooled[t].append(ms[t])
+            failed[t] += fails[t]
+        _report(name, ms, fails, args.reference)
+    _report("ALL (pooled)", {t: np.concatenate(v) for t, v in pooled.items()}, failed, args.reference)
+    return 0
+
+
+def _report(name: str, ms: dict[str, np.ndarray], fails: dict[str, int], reference: str) -> None:
+    """Per tracker: median / p95 update ms, fps = 1000 / mean ms, fps ratio, frames reported failed."""
+    ref_fps = 1e3 / ms[reference].mean()
+    for t, v in ms.items():
+        fps = 1e3 / v.mean()
+        print(f"{name:<22} {t:<6} {np.median(v):10.2f} {np.percentile(v, 95):8.2f} {fps:8.1f} "
+              f"{fps / ref_fps:7.2f} {fails[t]:7d}")
+    print(f"{'':<22} fps ratio vs {reference}: " +
+          ", ".join(f"{t}/{reference} = {1e3 / v.mean() / ref_fps:.2f}" for t, v in ms.items() if t != reference))
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,144 @@
+"""iemd-eval end to end (iemd_ros.evaluation): protocol wiring on synthetic data, CLI on real OTB frames."""
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from iemd_ros import evaluation
+from iemd_ros.evaluation import main, make_tracker, run_tracker
+from iemd_ros.otb import load_sequence
+
+REPO = Path(__file__).resolve().parents[1]
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+# Measured on Car4 frames 1-20 (OpenCV 5.0.0 contrib): CSRT average overlap 85.8 %, KCF 87.9 %.
+CSRT_CAR4_20_MIN_OVERLAP = 0.75
+
+
+def _synthetic_root(tmp_path: Path, n: int = 6) -> tuple[Path, np.ndarray]:
+    seq = tmp_path / "data" / "Toy"
+    (seq / "img").mkdir(parents=True)
+    gt1 = np.array([[11 + 2 * k, 21 + k, 10, 12] for k in range(n)], float)  # 1-based
+    for k in range(n):
+        cv2.imwrite(str(seq / "img" / f"{k + 1:04d}.jpg"), np.full((60, 80, 3), k, np.uint8))
+    (seq / "groundtruth_rect.txt").write_text("\n".join(",".join(f"{v:g}" for v in b) for b in gt1))
+    return tmp_path / "data", gt1 - [1, 1, 0, 0]
+
+
+class _Oracle:
+    """Fake tracker that returns the 0-based GT of the frame it is given (frame k has brightness k)."""
+
+    gt: np.ndarray
+
+    def init(self, frame, box):
+        assert int(frame[0, 0, 0]) == 0
+        np.testing.assert_array_equal(box, self.gt[0])
+
+    def update(self, frame):
+        k = int(round(frame.mean()))
+        return self.gt[k], k != 3  # reports one failure, at frame index 3
+
+
+def test_protocol_with_oracle_tracker(tmp_path, monkeypatch, capsys):
+    root, gt = _synthetic_root(tmp_path)
+    _Oracle.gt = gt
+    monkeypatch.setitem(evaluation.TRACKERS, "oracle", _Oracle)
+    out = tmp_path / "out"
+    assert main([str(root), "--trackers", "oracle", "--out", str(out), "--max-frames", "5"]) == 0
+    doc = json.loads((out / "results.json").read_text())
+    res = doc["results"]["oracle"]["Toy"]
+    np.testing.assert_array_equal(res["boxes"], gt[:5])  # frame/GT alignment, first frame = GT
+    assert res["average_overlap"] == 1.0 and res["precision_20"] == 1.0 and res["n_frames"] == 5
+    assert res["failures"] == 1 and res["ok"] == [True, True, True, False, True]
+    assert doc["results"]["oracle"]["mean"]["success_auc"] == pytest.approx(20 / 21)
+    assert "Toy" in capsys.readouterr().out
+
+
+def test_run_tracker_keeps_last_box_when_tracker_returns_none():
+    class Flaky:
+        def init(self, frame, box):
+            self.k = 0
+
+        def update(self, frame):
+            self.k += 1
+            if self.k in (2, 3):
+                return np.zeros(4), False          # what cv2.TrackerCSRT/KCF return when lost
+            if self.k == 4:
+                return np.full(4, np.nan), True    # no box at all
+            return np.array([self.k, 0, 5, 5.0]), True
+
+    frames = [np.zeros((8, 8, 3), np.uint8)] * 6
+    run = run_tracker(Flaky(), frames, (1, 1, 4, 4))
+    assert run.ok.tolist() == [True, True, False, False, True, True] and run.update_seconds.shape == (5,)
+    np.testing.assert_array_equal(run.boxes[:, 0], [1, 1, 1, 1, 1, 5])  # frames 2-4 hold frame 1's box
+    np.testing.assert_array_equal(run.boxes[0], [1, 1, 4, 4])
+
+
+def test_opencv_failure_returns_empty_box_and_keeps_position(otb_root):
+    """Backs the hold-last rule: OpenCV's failure box is (0,0,0,0); the tracker resumes where it was."""
+    seq = load_sequence("Car4", otb_root).head(3)
+    f0, f1, _ = list(seq.frames())
+    noise = np.random.default_rng(0).integers(0, 256, f0.shape, dtype=np.uint8)
+    trk = make_tracker("kcf")
+    trk.init(f0, seq.gt_boxes[0])
+    box1, ok1 = trk.update(f1)
+    box_fail, ok_fail = trk.update(noise)
+    box_back, ok_back = trk.update(f1)
+    assert ok1 and not ok_fail and np.all(box_fail == 0)
+    assert ok_back and np.abs(box_back - box1).max() <= 2  # resumed from its last position
+
+
+def test_cli_real_excerpt_csrt_kcf(otb_root, tmp_path, capsys):
+    out = tmp_path / "eval"
+    rc = main([str(otb_root), "--trackers", "csrt,kcf", "--sequences", "Car4", "--max-frames", "20", "--out", str(out)])
+    assert rc == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert {"protocol", "trackers", "sequences", "ground_truth", "results"} <= doc.keys()
+    assert doc["trackers"] == ["csrt", "kcf"] and doc["sequences"] == ["Car4"]
+    for trk in ("csrt", "kcf"):
+        car = doc["results"][trk]["Car4"]
+        for key in ("average_overlap", "success_auc", "precision_20", "overlap_gt_0", "overlap_gt_04", "fps",
+                    "success_curve", "boxes", "failures"):
+            assert key in car, (trk, key)
+        assert len(car["boxes"]) == 20 and len(car["success_curve"]) == 21
+        assert car["boxes"][0] == doc["ground_truth"]["Car4"][0]
+        assert 0 < car["fps"] < 1e6
+        assert doc["results"][trk]["mean"]["average_overlap"] == pytest.approx(car["average_overlap"])
+    assert doc["results"]["csrt"]["Car4"]["average_overlap"] > CSRT_CAR4_20_MIN_OVERLAP
+    for png in ("success_Car4.png", "success_overall.png"):
+        data = (out / png).read_bytes()
+        assert data[:8] == PNG_SIGNATURE
+        img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+        assert img is not None and img.shape[0] > 100 and img.shape[1] > 100
+    table = capsys.readouterr().out
+    assert "MEAN (1)" in table and "csrt" in table and "kcf" in table
+
+
+@pytest.mark.parametrize(
+    "argv, match",
+    [
+        (["--trackers", "nope"], "unknown tracker 'nope'"),
+        (["--sequences", "NoSuchSeq", "--trackers", "kcf"], "unknown sequence 'NoSuchSeq'"),
+        (["--max-frames", "zero", "--trackers", "kcf"], "not an integer"),
+        (["--max-frames", "1", "--trackers", "kcf"], "must be >= 2"),
+        (["--bogus"], "unrecognized arguments"),
+        (["/no/such/dir", "--trackers", "kcf"], "neither an OTB root nor a sequence folder"),
+    ],
+)
+def test_bad_arguments_exit_2_one_line(argv, match, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("iemd-eval: error:") and match in err
+
+
+def test_bad_argument_subprocess_no_traceback(tmp_path):
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    proc = subprocess.run([sys.executable, "-m", "iemd_ros.evaluation", str(tmp_path), "--trackers", "kcf"],
+                          capture_output=True, text=True, env=env, timeout=60)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+    assert "holds no OTB sequence" in proc.stderr
