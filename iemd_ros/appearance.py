@@ -123,13 +123,38 @@ class PatchLayout:
         patch inside a narrow cone of positive vectors: appearance distances
         and code weights then barely separate target from background.
         """
-        pw, ph = self.patch_size
-        patches = sliding_window_view(template, (ph, pw))[:: self.step, :: self.step]
-        vectors = patches.reshape(-1, pw * ph).astype(np.float64)
+        return self._normalize(self._patches(template))[0]
+
+    def extract_with_jacobian(self, template: np.ndarray):
+        """epsilon (N, d) and its derivative (N, d, 2) with respect to moving the window.
+
+        The derivative is per template pixel of window motion (x, y): the patch
+        pixels' grey-level gradients (central differences of the template) pushed
+        through the mean removal and the normalization of :meth:`extract`.
+        """
+        gy, gx = np.gradient(np.asarray(template, dtype=np.float64))
+        vectors, norms, floor = self._normalize(self._patches(template))
+        eps = vectors
+        jac = np.stack([self._patches(gx), self._patches(gy)], axis=-1)  # d p / d y
         if self.zero_mean:
-            vectors -= vectors.mean(axis=1, keepdims=True)
+            jac -= jac.mean(axis=1, keepdims=True)
+        unit = (norms > floor)[:, :, None]
+        # d(p/||p||) = (I - eps eps') dp / ||p|| above the contrast floor, dp / floor below it.
+        projected = jac - eps[:, :, None] * np.einsum("nd,ndk->nk", eps, jac)[:, None, :]
+        jac = np.where(unit, projected, jac) / np.maximum(norms, floor)[:, :, None]
+        return eps, jac
+
+    def _patches(self, image: np.ndarray) -> np.ndarray:
+        pw, ph = self.patch_size
+        patches = sliding_window_view(image, (ph, pw))[:: self.step, :: self.step]
+        return patches.reshape(-1, pw * ph).astype(np.float64)
+
+    def _normalize(self, vectors: np.ndarray):
+        pw, ph = self.patch_size
+        if self.zero_mean:
+            vectors = vectors - vectors.mean(axis=1, keepdims=True)
             floor = self.min_contrast * np.sqrt(pw * ph)
         else:
             floor = 1e-6
         norms = np.linalg.norm(vectors, axis=1, keepdims=True)
-        return vectors / np.maximum(norms, floor)
+        return vectors / np.maximum(norms, floor), norms, floor

@@ -1,12 +1,16 @@
-"""The candidate model of one frame: a lattice of local patches, coded once each.
+"""The candidate model at one window position (eq. sparse candidate model).
 
-Eq. (sparse candidate model) weights *fixed* patches c_r by a kernel centred at
-the window position y, so moving y only changes kernel weights.  The lattice
-continues the window's patch grid (same size and step, in template pixels of
-the window size being searched) in every direction; a patch is sampled and
-sparse-coded the first time the kernel reaches it and then reused for every
-later position in the frame.  Positions are normalized to the anchor window
-(the window at the start of the search), which spans [-1, 1]^2.
+Algorithm 1 builds a new candidate model each time the window moves: the
+window at ``center`` is resampled to the template size and cut into the same
+patch grid as the target, so candidate patch v and target patch u are aligned
+whenever the window sits on the target (a fixed patch lattice that is not
+re-sampled is misaligned between its grid points: on a pure 2.4 px
+translation its EMD minimum sat 1.2 px short of the truth).
+
+The gradient of eq. (10) is taken at the model's own position, treating its
+patches as fixed while the kernel centre y moves (as in mean shift);
+:meth:`CandidateModel.evaluate` therefore accepts small offsets y, which the
+tests use to check the gradients against finite differences.
 """
 from __future__ import annotations
 
@@ -18,79 +22,58 @@ from .histogram import candidate_weights
 from .sparse_coding import SparseCoder, max_alignment_pooling
 
 
-class CandidateLattice:
-    """Patches of one frame around an anchor window, coded on demand."""
+class CandidateModel:
+    """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``."""
 
-    def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, anchor_center, size,
-                 coder: SparseCoder, n_templates: int, target_eps: np.ndarray, alpha: float,
-                 target_codes: np.ndarray):
-        self.pyramid = pyramid
-        self.layout = layout
-        self.center = np.asarray(anchor_center, dtype=np.float64)
+    def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, coder: SparseCoder,
+                 n_templates: int, target_eps: np.ndarray, alpha: float, warm: np.ndarray | None = None):
+        self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
-        self.coder = coder
-        self.n_templates = n_templates
-        self.target_eps = target_eps
         self.alpha = alpha
-        self.target_codes = target_codes  # warm starts: codes of the target patch at the same cell
-        self._index: dict[tuple[int, int], int] = {}
-        self.pos = np.zeros((0, 2))
-        self.code_weights = np.zeros(0)
-        self.appearance_cost = np.zeros((len(target_eps), 0))
-        self.codings = 0  # patches sparse-coded so far
+        template = pyramid.sample(self.center, self.size, layout.template_size)
+        self.eps, jac = layout.extract_with_jacobian(template)
+        # d epsilon / d (window centre in image pixels): template pixels per image pixel.
+        self.eps_jacobian = jac * (np.asarray(layout.template_size, dtype=np.float64) / self.size)
+        self.pos = layout.positions()
+        self.codes = coder.encode(self.eps.T, warm=warm)
+        self.code_weights = max_alignment_pooling(self.codes, n_templates)
+        self.appearance_cost = alpha * appearance_distance(target_eps, self.eps)
 
-    def ensure(self, y: np.ndarray, radius: float) -> None:
-        """Sample and code every lattice cell whose centre lies within ``radius`` of ``y``."""
-        tw, th = self.layout.template_size
-        pw, ph = self.layout.patch_size
-        step = self.layout.step
-        first = self.layout.cell_positions(0, 0)[0]
-        dx, dy = 2.0 * step / tw, 2.0 * step / th
-        i0, i1 = int(np.ceil((y[0] - radius - first[0]) / dx)), int(np.floor((y[0] + radius - first[0]) / dx))
-        j0, j1 = int(np.ceil((y[1] - radius - first[1]) / dy)), int(np.floor((y[1] + radius - first[1]) / dy))
-        gi, gj = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
-        missing = [(i, j) for i, j in zip(gi.ravel(), gj.ravel()) if (i, j) not in self._index]
-        if not missing:
-            return
-        mi = np.array([m[0] for m in missing])
-        mj = np.array([m[1] for m in missing])
-        a0, b0 = mi.min(), mj.min()
-        region = self.pyramid.sample(
-            self.center, self.size, self.layout.template_size, origin=(a0 * step, b0 * step),
-            out_size=((mi.max() - a0) * step + pw, (mj.max() - b0) * step + ph),
-        )
-        n_cols = mi.max() - a0 + 1
-        eps_all = self.layout.extract(region)
-        eps = eps_all[(mj - b0) * n_cols + (mi - a0)]
-        nx, ny = self.layout.cells
-        nearest = np.clip(mj, 0, ny - 1) * nx + np.clip(mi, 0, nx - 1)
-        codes = self.coder.encode(eps.T, warm=self.target_codes[:, nearest])
-        start = len(self.pos)
-        for k, cell in enumerate(missing):
-            self._index[cell] = start + k
-        self.pos = np.vstack([self.pos, self.layout.cell_positions(mi, mj)])
-        self.code_weights = np.concatenate([self.code_weights, max_alignment_pooling(codes, self.n_templates)])
-        self.appearance_cost = np.hstack(
-            [self.appearance_cost, self.alpha * appearance_distance(self.target_eps, eps)])
-        self.codings += len(missing)
+    def evaluate(self, y, bandwidth: float, target_pos, target_eps, target_weights, gradient: str):
+        """EMD between the target and the kernel centred at offset ``y`` (normalized), and dEMD/dy.
 
-    def evaluate(self, y, scale, bandwidth, target_pos, target_weights, full_gradient: bool):
-        """EMD between the target and the candidate at (y, scale), and dEMD/dy.
-
-        Returns (emd, gradient (2,), EmdSolution or None when no bin has weight).
-        ``full_gradient`` selects the envelope gradient over the paper's eq. (10).
+        Returns (emd, gradient (2,) per normalized unit, EmdSolution or None when
+        no bin has weight).  ``gradient``:
+        - "paper": eq. (10), the duals times dw_C/dy (patches fixed, kernel moves);
+        - "envelope": the same model with the spatial ground distance moving too,
+          sum_uv f_uv dd_uv/dy + sum_v v_v dw_C,v/dy;
+        - "appearance": the derivative of the re-sampled model that Algorithm 1
+          evaluates (only at y = 0): when the window moves its patches are
+          re-sampled, so d_uv changes through epsilon_v(y); with the flow fixed
+          (envelope theorem) dD*/dy = -2 alpha sum_v (sum_u f_uv eps_u - w_v eps_v)
+          . d eps_v/dy.  The pooled code weights also move with the content; that
+          term is left out (they change slowly and have no closed-form derivative).
         """
-        self.ensure(y, bandwidth * scale)
-        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, scale, bandwidth)
+        y = np.asarray(y, dtype=np.float64)
+        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, 1.0, bandwidth)
         keep = w_c > 0
         if not keep.any():
             return np.inf, np.zeros(2), None
-        rel = (self.pos[keep] - y) / scale
+        rel = self.pos[keep] - y
         diff = target_pos[:, None, :] - rel[None, :, :]
         cost = self.appearance_cost[:, keep] + (1.0 - self.alpha) * (diff**2).sum(-1)
         solution: EmdSolution = solve_emd(target_weights, w_c[keep], cost)
-        if full_gradient:
-            grad = envelope_gradient(solution, dw_dy[keep], 2.0 * (1.0 - self.alpha) / scale * diff)
-        else:
+        if gradient == "paper":
             grad = emd_gradient(solution, dw_dy[keep])
+        elif gradient == "envelope":
+            grad = envelope_gradient(solution, dw_dy[keep], 2.0 * (1.0 - self.alpha) * diff)
+        elif gradient == "appearance":
+            if np.any(y != 0):
+                raise ValueError("the appearance gradient is defined at the model's own position (y = 0)")
+            flow = solution.flow
+            residual = flow.T @ target_eps - flow.sum(0)[:, None] * self.eps[keep]
+            grad_px = -2.0 * self.alpha * np.einsum("nd,ndk->k", residual, self.eps_jacobian[keep])
+            grad = grad_px * self.size / 2.0  # per normalized unit, like the other two
+        else:
+            raise ValueError(f"unknown gradient {gradient!r}")
         return solution.value, grad, solution

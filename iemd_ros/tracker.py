@@ -2,12 +2,11 @@
 
 OpenCV-style API: ``init(frame, box)`` then ``update(frame, prior=None)``.
 
-Per frame: the candidate patches are sampled once on a grid that extends the
-window by ``search_margin`` template pixels, and coded once; the window centre
-y then moves over these fixed patches, which only changes the kernel weights
-w_C,v(y) of eq. (sparse candidate model) and the spatial part of the ground
-distance, exactly the model the gradient of eq. (10) differentiates.  The grid
-is resampled (and recoded) only when y leaves half the margin.
+Per frame and starting point: build the candidate model at the window
+(resample, cut into patches, sparse-code with the target's codes as warm
+start), solve the EMD, move the window against the EMD gradient, and repeat
+while the EMD decreases (backtracking the step when it does not); then try
+the scale variants at the converged window.
 """
 from __future__ import annotations
 
@@ -17,8 +16,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from .appearance import ImagePyramid, PatchLayout, to_gray
-from .candidate import CandidateLattice
-from .emd import ground_distance, solve_emd
+from .candidate import CandidateModel
 from .histogram import target_weights
 from .sparse_coding import max_alignment_pooling
 from .template import TemplateDictionary
@@ -39,7 +37,7 @@ class TrackerConfig:
     n_iter: int = 20  # maximum descent iterations per start
     step_px: float = 2.0  # first step along the descent direction, image pixels
     min_step_px: float = 0.25  # stop when backtracking has halved the step below this
-    gradient: str = "envelope"  # "envelope" (full derivative) or "paper" (eq. 10)
+    gradient: str = "appearance"  # "appearance", "envelope" or "paper" (eq. 10): see CandidateModel.evaluate
     scale_step: float = 0.02  # relative scale variants tried at the converged position
     n_particles: int = 4  # extra starting points for abrupt motion (section 6.1)
     particle_offset: float = 0.5  # their distance from the prediction, in window sizes
@@ -61,7 +59,8 @@ class TrackerConfig:
             (self.kernel_bandwidth > 0, "kernel_bandwidth must be > 0"),
             (self.n_iter >= 0, "n_iter must be >= 0"),
             (0 < self.min_step_px <= self.step_px, "need 0 < min_step_px <= step_px"),
-            (self.gradient in ("envelope", "paper"), "gradient must be 'envelope' or 'paper'"),
+            (self.gradient in ("appearance", "envelope", "paper"),
+             "gradient must be 'appearance', 'envelope' or 'paper'"),
             (0 <= self.scale_step < 0.5, "scale_step must be in [0, 0.5)"),
             (self.n_particles >= 0 and self.particle_offset >= 0, "particles must be >= 0"),
             (self.particle_trigger >= 0 and self.lost_factor > 1, "need particle_trigger >= 0, lost_factor > 1"),
@@ -94,7 +93,7 @@ class TrackResult:
     lost: bool
     scale: float = 1.0  # relative scale change chosen this frame
     starts: int = 1  # starting points searched (1 + particles when triggered)
-    codings: int = 0  # candidate grids sampled and sparse-coded this frame
+    codings: int = 0  # candidate models built (windows sampled and sparse-coded) this frame
     solver_warnings: int = 0  # EMD solves that did not end optimal
     predicted_box: tuple[float, float, float, float] | None = None
     reason: str = ""
@@ -114,9 +113,11 @@ class _Target:
 class _Descent:
     """Outcome of Algorithm 1 from one starting point."""
 
-    y: np.ndarray  # window centre, normalized to the lattice's anchor window
+    center: np.ndarray  # window centre, image pixels
     emd: float
+    model: CandidateModel | None = None  # candidate model at the centre
     iterations: int = 0
+    codings: int = 1  # candidate models built (each sparse-codes one window)
     warnings: int = 0
 
 
@@ -168,24 +169,20 @@ class IemdTracker:
         predicted = _box(center, size)
         pyramid = ImagePyramid(to_gray(frame))
 
-        lattice = CandidateLattice(pyramid, self.layout, center, size, self.dictionary.coder,
-                                   len(self.dictionary.templates), self._target.eps, cfg.alpha,
-                                   self._target.codes)
-        best = self._descend(lattice, np.zeros(2))
-        starts = 1
+        best = self._descend(pyramid, center, size)
+        starts, codings = 1, best.codings
         baseline = self._baseline()
         trigger = cfg.particle_trigger * baseline if baseline else np.inf
         if cfg.n_particles and (self._lost or cfg.particle_trigger == 0 or best.emd > trigger):
             # Section 6.1: more starting points around the prediction for abrupt motion.
-            distance = cfg.particle_offset * (2.0 if self._lost else 1.0) * 2.0  # window sizes -> normalized
+            distance = cfg.particle_offset * (2.0 if self._lost else 1.0)
             for offset in _particle_offsets(cfg.n_particles, distance):
-                candidate = self._descend(lattice, offset)
-                starts += 1
+                candidate = self._descend(pyramid, center + offset * size, size)
+                starts, codings = starts + 1, codings + candidate.codings
                 if candidate.emd < best.emd:
                     best = candidate
-        new_center = center + best.y * size / 2.0
-        scale, emd, scale_codings = self._search_scale(pyramid, new_center, size, best.emd)
-        new_size = size * scale
+        scale, emd, scale_codings = self._search_scale(pyramid, best, size)
+        new_center, new_size = best.center, size * scale
         best_box = _box(new_center, new_size)
         visible = _visible_fraction(new_center, new_size, frame.shape)
         reason = ""
@@ -205,7 +202,7 @@ class IemdTracker:
                     self._refresh_target_weights()
         return TrackResult(
             box=best_box, emd=emd, iterations=best.iterations, lost=lost, scale=scale, starts=starts,
-            codings=lattice.codings + scale_codings, solver_warnings=best.warnings,
+            codings=codings + scale_codings, solver_warnings=best.warnings,
             predicted_box=predicted, reason=reason,
         )
 
@@ -219,8 +216,18 @@ class IemdTracker:
         pooled = max_alignment_pooling(codes, len(self.dictionary.templates))
         self._target.weights = target_weights(pooled, self._target.pos, self.config.kernel_bandwidth)
 
-    def _descend(self, lattice: CandidateLattice, y0: np.ndarray) -> _Descent:
-        """Algorithm 1 from the start ``y0``: move along -dEMD/dy while the EMD decreases.
+    def _candidate(self, pyramid: ImagePyramid, center, size) -> CandidateModel:
+        return CandidateModel(pyramid, self.layout, center, size, self.dictionary.coder,
+                              len(self.dictionary.templates), self._target.eps, self.config.alpha,
+                              warm=self._target.codes)
+
+    def _evaluate(self, model: CandidateModel):
+        target = self._target
+        return model.evaluate(np.zeros(2), self.config.kernel_bandwidth, target.pos, target.eps, target.weights,
+                              self.config.gradient)
+
+    def _descend(self, pyramid: ImagePyramid, center, size) -> _Descent:
+        """Algorithm 1 from one start: move against dEMD/dy while the EMD decreases.
 
         The paper moves one pixel along the gradient and stops at the first EMD
         increase.  We start with ``step_px`` and halve the step on an increase,
@@ -229,12 +236,11 @@ class IemdTracker:
         covers larger motions in fewer EMD solves.
         """
         cfg = self.config
-        half = lattice.size / 2.0
-        target = self._target
-        full = cfg.gradient == "envelope"
-        y = np.asarray(y0, dtype=np.float64)
-        emd, grad, sol = lattice.evaluate(y, 1.0, cfg.kernel_bandwidth, target.pos, target.weights, full)
-        state = _Descent(y=y, emd=emd, warnings=int(sol is not None and not sol.optimal))
+        half = np.asarray(size, dtype=np.float64) / 2.0
+        model = self._candidate(pyramid, center, size)
+        emd, grad, sol = self._evaluate(model)
+        state = _Descent(center=model.center, emd=emd, model=model,
+                         warnings=int(sol is not None and not sol.optimal))
         step = cfg.step_px
         while state.iterations < cfg.n_iter and step >= cfg.min_step_px:
             g_px = grad / half  # gradient with respect to image pixels
@@ -242,45 +248,35 @@ class IemdTracker:
             if not np.isfinite(norm) or norm == 0:
                 break
             state.iterations += 1
-            y_try = state.y - step * (g_px / norm) / half
-            e_try, g_try, s_try = lattice.evaluate(y_try, 1.0, cfg.kernel_bandwidth, target.pos,
-                                                   target.weights, full)
+            trial = self._candidate(pyramid, state.center - step * g_px / norm, size)
+            e_try, g_try, s_try = self._evaluate(trial)
+            state.codings += 1
             state.warnings += int(s_try is not None and not s_try.optimal)
             if e_try < state.emd:
-                state.y, state.emd, grad = y_try, e_try, g_try
+                state.center, state.emd, state.model, grad = trial.center, e_try, trial, g_try
             else:
                 step *= 0.5
         return state
 
-    def _search_scale(self, pyramid: ImagePyramid, center, size, emd_at_scale_one: float):
+    def _search_scale(self, pyramid: ImagePyramid, state: _Descent, size):
         """Scale variants at the converged centre (paper: window enlarged/shrunk by 2%).
 
-        Each variant is resampled to the template size, so the candidate has
-        exactly the target's patch layout and only its content differs; the
-        three EMDs are comparable.  (Scaling the kernel over the fixed lattice
-        instead lets more bins in at larger scales and biased the EMD toward
-        growing windows: measured as runaway growth on Car4.)
-        Returns (scale, emd, patches coded).
+        Each variant is a candidate model of the window resampled at s * size, so it
+        has exactly the target's patch layout and its EMD is comparable with the
+        EMD at scale 1.  (Scaling the kernel over fixed patches instead lets more
+        bins in at larger scales and biased the EMD toward growing windows:
+        measured as runaway growth on Car4.)  Returns (scale, emd, models built).
         """
         cfg = self.config
+        best_scale, best_emd, codings = 1.0, state.emd, 0
         if cfg.scale_step == 0:
-            return 1.0, emd_at_scale_one, 0
-        best_emd, best_scale, codings = np.inf, 1.0, 0
-        warm = self._target.codes  # the variants have the target's layout; then each other's
-        for scale in (1.0, 1.0 - cfg.scale_step, 1.0 + cfg.scale_step):
-            template = pyramid.sample(center, size * scale, cfg.template_size)
-            eps = self.layout.extract(template)
-            codes = self.dictionary.coder.encode(eps.T, warm=warm)
-            warm = codes if scale == 1.0 else warm
-            codings += len(eps)
-            pooled = max_alignment_pooling(codes, len(self.dictionary.templates))
-            if not pooled.any():
-                continue
-            w_c = target_weights(pooled, self._target.pos, cfg.kernel_bandwidth)
-            cost = ground_distance(self._target.eps, self._target.pos, eps, self._target.pos, cfg.alpha)
-            solution = solve_emd(self._target.weights, w_c, cost)
-            if solution.value < best_emd:
-                best_emd, best_scale = solution.value, scale
+            return best_scale, best_emd, codings
+        for scale in (1.0 - cfg.scale_step, 1.0 + cfg.scale_step):
+            emd, _, sol = self._evaluate(self._candidate(pyramid, state.center, size * scale))
+            codings += 1
+            state.warnings += int(sol is not None and not sol.optimal)
+            if emd < best_emd:
+                best_scale, best_emd = scale, emd
         return best_scale, best_emd, codings
 
 

@@ -1,0 +1,97 @@
+"""Camera model: plumb_bob distortion round trip, CameraInfo parsing, image undistortion."""
+import cv2
+import numpy as np
+import pytest
+
+from iemd_ros.camera import CameraModel
+
+DESK = dict(image_width=640, image_height=480,
+            camera_matrix=dict(rows=3, cols=3, data=[570.246, -0.100721, 309.408, 0, 569.324, 217.996, 0, 0, 1]),
+            distortion_model="plumb_bob", distortion_coefficients=dict(rows=1, cols=5, data=[-0.346217, 0.128289, 0, 0, 0]))
+
+
+def grid(w, h, step=4):
+    u, v = np.meshgrid(np.arange(0, w, step, dtype=float), np.arange(0, h, step, dtype=float))
+    return np.stack([u.ravel(), v.ravel()], 1)
+
+
+@pytest.mark.parametrize("D", [[-0.346217, 0.128289, 0, 0, 0], [-0.2, 0.05, 0.001, -0.002, 0.01]])
+def test_distortion_round_trip_inside_the_image(D):
+    cam = CameraModel.from_camera_info({**DESK, "distortion_coefficients": {"data": D}})
+    raw = grid(640, 480)
+    und = cam.undistort_points(raw)
+    assert np.all(np.isfinite(und))
+    back = cam.distort_points(und)
+    assert np.abs(back - raw).max() < 0.01
+    assert np.abs(back - raw).max() < 1e-6          # Newton actually converges
+    # barrel distortion: the raw corners come from further out in the pinhole image
+    assert np.hypot(*(und[0] - cam.K[:2, 2])) > np.hypot(*(raw[0] - cam.K[:2, 2])) + 20
+
+
+def test_undistort_points_agrees_with_opencv_when_there_is_no_skew():
+    K = np.array([[570.0, 0, 309.4], [0, 569.3, 218.0], [0, 0, 1]])
+    D = np.array([-0.346217, 0.128289, 0.0005, -0.0003, 0.0])
+    cam = CameraModel(K, D, 640, 480)
+    raw = grid(640, 480, 37)
+    ours = cam.undistort_points(raw)
+    ocv = cv2.undistortPoints(raw[:, None, :], K, D, P=K,
+                              criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 200, 1e-12))[:, 0]
+    assert np.abs(ours - ocv).max() < 0.01
+    # OpenCV's default (5 fixed-point iterations) is not accurate enough at the corners
+    ocv5 = cv2.undistortPoints(raw[:, None, :], K, D, P=K)[:, 0]
+    assert np.abs(cam.distort_points(ocv5) - raw).max() > 0.01
+
+
+def test_skew_is_honoured():
+    cam = CameraModel.from_camera_info(DESK)
+    p = cam.distort_points(np.array([[100.0, 400.0]]))
+    x = np.linalg.solve(cam.K, [100.0, 400.0, 1.0])
+    r2 = x[0] ** 2 + x[1] ** 2
+    xd = x[:2] * (1 + cam.D[0] * r2 + cam.D[1] * r2 ** 2)
+    np.testing.assert_allclose(p[0], (cam.K @ np.r_[xd, 1.0])[:2], atol=1e-9)
+
+
+def test_camera_info_variants_and_errors(tmp_path):
+    msg = dict(width=640, height=480, k=DESK["camera_matrix"]["data"], d=[-0.3, 0.1, 0, 0, 0],
+               distortion_model="plumb_bob")
+    cam = CameraModel.from_camera_info(msg)
+    assert (cam.width, cam.height) == (640, 480) and cam.D[0] == -0.3
+    again = CameraModel.from_camera_info(cam.to_camera_info())
+    np.testing.assert_array_equal(again.K, cam.K)
+    np.testing.assert_array_equal(again.D, cam.D)
+    assert not CameraModel.from_camera_info({**msg, "d": []}).has_distortion
+    with pytest.raises(ValueError, match="camera_matrix"):
+        CameraModel.from_camera_info({"width": 1})
+    with pytest.raises(ValueError, match="unsupported distortion_model"):
+        CameraModel.from_camera_info({**msg, "distortion_model": "equidistant"})
+    with pytest.raises(ValueError, match="fx, fy > 0"):
+        CameraModel(np.diag([0.0, 1.0, 1.0]))
+    with pytest.raises(ValueError, match="plumb_bob"):
+        CameraModel(np.eye(3), np.ones(8))
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("camera_matrix: [unclosed")
+    with pytest.raises(ValueError, match="cannot read camera YAML"):
+        CameraModel.from_yaml(bad)
+
+
+def test_undistort_image_straightens_a_distorted_line():
+    cam = CameraModel.from_camera_info(DESK)
+    und_line = np.stack([np.linspace(40, 600, 400), np.full(400, 60.0)], 1)      # straight in the pinhole image
+    raw_line = cam.distort_points(und_line)
+    img = np.zeros((480, 640), np.uint8)
+    cv2.polylines(img, [np.round(raw_line * 16).astype(np.int32)], False, 255, 3, cv2.LINE_AA, shift=4)
+    und = cam.undistort_image(img)
+    cols = np.arange(80, 560, 40)
+    rows = [np.average(np.arange(480), weights=und[:, c].astype(float) + 1e-9) for c in cols]
+    assert np.ptp(rows) < 1.0                                   # straight again, at y = 60
+    assert abs(np.mean(rows) - 60) < 0.5
+    raw_rows = [np.average(np.arange(480), weights=img[:, c].astype(float) + 1e-9) for c in cols]
+    assert np.ptp(raw_rows) > 5                                  # it was curved
+
+
+def test_real_camera_yaml(imu_root):
+    cam = CameraModel.from_yaml(imu_root / "cmu_hwangbo_desk" / "derived_camera_info.yaml")
+    assert (cam.width, cam.height) == (640, 480)
+    assert cam.D[0] == pytest.approx(-0.346217) and cam.K[0, 1] == pytest.approx(-0.100721)
+    raw = grid(640, 480, 8)
+    assert np.abs(cam.distort_points(cam.undistort_points(raw)) - raw).max() < 0.01

@@ -1,0 +1,99 @@
+"""EMD (section 3): optimal value, duals, and the two gradients with respect to y."""
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from iemd_ros.emd import appearance_distance, ground_distance, solve_emd, spatial_distance
+
+
+def linprog_emd(w_t, w_c, cost):
+    """Reference: the transportation problem of eqs. (4)-(8) with HiGHS."""
+    n_t, n_c = cost.shape
+    a_eq = np.zeros((n_t + n_c, n_t * n_c))
+    for u in range(n_t):
+        a_eq[u, u * n_c:(u + 1) * n_c] = 1.0
+    for v in range(n_c):
+        a_eq[n_t + v, v::n_c] = 1.0
+    res = linprog(cost.ravel(), A_eq=a_eq, b_eq=np.concatenate([w_t, w_c]), bounds=(0, None), method="highs")
+    assert res.status == 0
+    return res.fun
+
+
+def random_problem(rng, n_t, n_c, dim=16):
+    eps_t = rng.normal(size=(n_t, dim))
+    eps_c = rng.normal(size=(n_c, dim))
+    eps_t /= np.linalg.norm(eps_t, axis=1, keepdims=True)
+    eps_c /= np.linalg.norm(eps_c, axis=1, keepdims=True)
+    pos_t = rng.uniform(-1, 1, (n_t, 2))
+    pos_c = rng.uniform(-1, 1, (n_c, 2))
+    w_t = rng.uniform(0.1, 1, n_t)
+    w_c = rng.uniform(0.1, 1, n_c)
+    return w_t / w_t.sum(), w_c / w_c.sum(), ground_distance(eps_t, pos_t, eps_c, pos_c, 0.4)
+
+
+@pytest.mark.parametrize("n_t,n_c", [(9, 9), (49, 49), (49, 81), (30, 12)])
+def test_emd_equals_linprog_optimum(n_t, n_c):
+    rng = np.random.default_rng(n_t * 100 + n_c)
+    w_t, w_c, cost = random_problem(rng, n_t, n_c)
+    sol = solve_emd(w_t, w_c, cost)
+    assert sol.optimal
+    assert sol.value == pytest.approx(linprog_emd(w_t, w_c, cost), rel=1e-9, abs=1e-12)
+    # The flow is feasible (eqs. 5-8) and its cost is the value.
+    assert np.allclose(sol.flow.sum(1), w_t) and np.allclose(sol.flow.sum(0), w_c)
+    assert sol.flow.min() >= -1e-15
+    assert (sol.flow * cost).sum() == pytest.approx(sol.value, rel=1e-12)
+
+
+def test_strong_duality_and_dual_feasibility():
+    rng = np.random.default_rng(1)
+    w_t, w_c, cost = random_problem(rng, 49, 49)
+    sol = solve_emd(w_t, w_c, cost)
+    assert sol.u @ w_t + sol.v @ w_c == pytest.approx(sol.value, rel=1e-10)
+    # Dual constraint H' pi <= d of eq. (8), with equality on the used flows.
+    reduced = cost - sol.u[:, None] - sol.v[None, :]
+    assert reduced.min() > -1e-10
+    assert np.abs(reduced[sol.flow > 1e-12]).max() < 1e-10
+
+
+def test_duals_are_the_derivative_of_emd_wrt_candidate_weights():
+    """Eq. (9): on the optimal basis D* is linear in w_C with slope v (mass-preserving moves)."""
+    rng = np.random.default_rng(2)
+    w_t, w_c, cost = random_problem(rng, 25, 25)
+    sol = solve_emd(w_t, w_c, cost)
+    for _ in range(5):
+        direction = rng.normal(size=w_c.size)
+        direction -= direction.mean()  # keep the total mass
+        h = 1e-7
+        d_plus = solve_emd(w_t, w_c + h * direction, cost).value
+        d_minus = solve_emd(w_t, w_c - h * direction, cost).value
+        assert (d_plus - d_minus) / (2 * h) == pytest.approx(sol.v @ direction, rel=1e-5, abs=1e-9)
+
+
+def test_non_optimal_exit_is_reported_not_hidden():
+    rng = np.random.default_rng(3)
+    w_t, w_c, cost = random_problem(rng, 60, 60)
+    sol = solve_emd(w_t, w_c, cost, max_iter=5)
+    assert not sol.optimal
+    assert "iteration" in sol.message.lower() or sol.message != "optimal"
+
+
+def test_invalid_weights_are_rejected():
+    cost = np.ones((2, 2))
+    with pytest.raises(ValueError, match="equal total"):
+        solve_emd(np.array([0.5, 0.5]), np.array([0.5, 0.6]), cost)
+    with pytest.raises(ValueError, match="non-negative"):
+        solve_emd(np.array([1.5, -0.5]), np.array([0.5, 0.5]), cost)
+    with pytest.raises(ValueError, match="finite"):
+        solve_emd(np.array([0.5, 0.5]), np.array([0.5, 0.5]), np.array([[0, np.nan], [1, 1]]))
+    with pytest.raises(ValueError, match="does not match"):
+        solve_emd(np.array([0.5, 0.5]), np.array([0.5, 0.5]), np.ones((3, 2)))
+
+
+def test_ground_distance_terms_by_hand():
+    eps_t = np.array([[1.0, 0.0]])
+    eps_c = np.array([[0.0, 1.0], [1.0, 0.0]])
+    pos_t = np.array([[0.0, 0.0]])
+    pos_c = np.array([[0.5, 0.0], [0.0, -1.0]])
+    assert np.allclose(appearance_distance(eps_t, eps_c), [[2.0, 0.0]])
+    assert np.allclose(spatial_distance(pos_t, pos_c), [[0.25, 1.0]])
+    assert np.allclose(ground_distance(eps_t, pos_t, eps_c, pos_c, 0.3), [[0.3 * 2 + 0.7 * 0.25, 0.7 * 1.0]])

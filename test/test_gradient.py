@@ -1,0 +1,104 @@
+"""Gradients of the EMD with respect to the window position (eqs. 9-10 and the envelope form)."""
+import numpy as np
+import pytest
+
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.appearance import ImagePyramid, to_gray
+from iemd_ros.candidate import CandidateModel
+from iemd_ros.emd import solve_emd
+from iemd_ros.histogram import candidate_weights
+
+
+def smooth_texture(seed=0, shape=(240, 320)):
+    import cv2
+
+    rng = np.random.default_rng(seed)
+    noise = rng.uniform(0, 255, (shape[0] // 4, shape[1] // 4)).astype(np.float32)
+    img = cv2.resize(noise, (shape[1], shape[0]), interpolation=cv2.INTER_CUBIC)
+    return np.clip(img, 0, 255).astype(np.uint8)
+
+
+@pytest.fixture
+def model_setup():
+    import cv2
+
+    frame0 = smooth_texture()
+    shift = np.float32([[1, 0, 2.3], [0, 1, -1.6]])
+    frame1 = cv2.warpAffine(frame0, shift, (frame0.shape[1], frame0.shape[0]), borderMode=cv2.BORDER_REFLECT)
+    tracker = IemdTracker(TrackerConfig())
+    box = (120, 80, 48, 40)
+    tracker.init(frame0, box)
+    center = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
+    model = CandidateModel(ImagePyramid(to_gray(frame1)), tracker.layout, center, np.array(box[2:], float),
+                             tracker.dictionary.coder, len(tracker.dictionary.templates), tracker._target.eps,
+                             tracker.config.alpha, tracker._target.codes)
+    return tracker, model
+
+
+def emd_at(tracker, model, y):
+    t = tracker._target
+    return model.evaluate(y, tracker.config.kernel_bandwidth, t.pos, t.eps, t.weights, "envelope")
+
+
+@pytest.mark.parametrize("y0", [(0.03, -0.02), (-0.05, 0.04), (0.08, 0.01)])
+def test_envelope_gradient_matches_finite_differences(model_setup, y0):
+    tracker, model = model_setup
+    y0 = np.array(y0)
+    _, grad, _ = emd_at(tracker, model, y0)
+    h = 1e-6
+    fd = np.array([(emd_at(tracker, model, y0 + h * e)[0] - emd_at(tracker, model, y0 - h * e)[0]) / (2 * h)
+                   for e in np.eye(2)])
+    assert np.allclose(grad, fd, rtol=1e-3, atol=1e-6), (grad, fd)
+
+
+def test_paper_gradient_is_the_derivative_through_the_weights_only(model_setup):
+    """Eq. (10) differentiates D* through w_C(y) with the ground distances held fixed."""
+    tracker, model = model_setup
+    cfg, target = tracker.config, tracker._target
+    # A position where no model bin sits on the kernel boundary (there D* has a kink).
+    y0 = next(np.array(y) for y in [(0.04, -0.03), (0.037, -0.021), (0.051, 0.013), (0.021, 0.033)]
+              if np.abs(1 - ((model.pos - y) ** 2).sum(1) / cfg.kernel_bandwidth**2).min() > 1e-3)
+    _, grad_paper, _ = model.evaluate(y0, cfg.kernel_bandwidth, target.pos, target.eps, target.weights, "paper")
+    _, grad_full, _ = model.evaluate(y0, cfg.kernel_bandwidth, target.pos, target.eps, target.weights, "envelope")
+    h = 1e-6
+    probes = [y0 + d for d in (h, -h) for d in np.eye(2) * d]
+    keep = np.any([candidate_weights(model.code_weights, model.pos, y, 1.0, cfg.kernel_bandwidth)[0] > 0
+                   for y in [y0] + probes], axis=0)
+    rel = model.pos[keep] - y0
+    cost = model.appearance_cost[:, keep] + (1 - cfg.alpha) * (
+        (target.pos[:, None, :] - rel[None, :, :]) ** 2).sum(-1)
+
+    def frozen_cost_emd(y):
+        w, _ = candidate_weights(model.code_weights, model.pos, y, 1.0, cfg.kernel_bandwidth)
+        return solve_emd(target.weights, w[keep], cost).value
+
+    fd = np.array([(frozen_cost_emd(y0 + h * e) - frozen_cost_emd(y0 - h * e)) / (2 * h) for e in np.eye(2)])
+    assert np.allclose(grad_paper, fd, rtol=1e-3, atol=1e-6), (grad_paper, fd)
+    # The spatial term of the ground distance depends on y too: the paper's form misses it.
+    assert np.linalg.norm(grad_full - grad_paper) > 0.05 * np.linalg.norm(grad_full)
+
+
+def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
+    """The gradient Algorithm 1 needs: of the EMD of the candidate re-sampled at each position."""
+    import cv2
+
+    frame0 = smooth_texture(seed=4)
+    frame1 = cv2.warpAffine(frame0, np.float32([[1, 0, 1.3], [0, 1, 0.7]]), (frame0.shape[1], frame0.shape[0]),
+                            flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
+    tracker = IemdTracker(TrackerConfig(gradient="appearance"))
+    box = (120, 80, 48, 40)
+    tracker.init(frame0, box)
+    pyramid = ImagePyramid(to_gray(frame1))
+    center = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
+    size = np.array(box[2:], float)
+
+    def emd(c):
+        value, grad, _ = tracker._evaluate(tracker._candidate(pyramid, c, size))
+        return value, grad / (size / 2)  # per image pixel
+
+    _, grad = emd(center)
+    h = 0.05
+    fd = np.array([(emd(center + h * e)[0] - emd(center - h * e)[0]) / (2 * h) for e in np.eye(2)])
+    # The pooled code weights also move with the content and are left out of the analytic form.
+    assert np.linalg.norm(grad - fd) < 0.25 * np.linalg.norm(fd), (grad, fd)
+    assert grad @ fd > 0.95 * np.linalg.norm(grad) * np.linalg.norm(fd)

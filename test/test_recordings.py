@@ -1,0 +1,56 @@
+"""Loaders of the real recordings (CMU desk/aerial, phone) and of OTB-style ground-truth files."""
+import numpy as np
+import pytest
+
+from iemd_ros.recordings import CMU_TIME_OFFSET_NS, load_gt_boxes, load_recording
+
+
+def test_cmu_desk(imu_root):
+    rec = load_recording(imu_root / "cmu_hwangbo_desk")
+    assert rec.name == "desk" and len(rec) == 825
+    assert rec.frame_files[0].name == "desk_00001891_00069317.jpg" and rec.frame_files[0].exists()
+    assert rec.frame_stamps_ns[0] == 69_317_000_000 and rec.time_offset_ns == CMU_TIME_OFFSET_NS
+    assert rec.frame_imu_ns[0] == 69_297_000_000
+    assert np.all(np.diff(rec.frame_stamps_ns) > 0)
+    assert rec.gyro.shape == (9233, 3) and rec.accel.shape == (9233, 3)
+    assert np.sum(np.diff(rec.imu_t_ns) < 0) == 3                  # original row order kept
+    assert rec.camera.width == 640 and rec.camera.D[0] == pytest.approx(-0.346217)
+    # GT: 1-based "282,285,42.1,51,ok" -> 0-based
+    np.testing.assert_allclose(rec.gt_boxes[0], [281.0, 284.0, 42.1, 51.0])
+    assert rec.gt_boxes.shape == (825, 4) and np.isfinite(rec.gt_boxes).all()
+    assert (rec.gt_flags == "ok").sum() == 699 and (rec.gt_flags == "blur").sum() == 126
+    assert rec.load_frame(0).shape == (480, 640, 3) and rec.load_frame(0, grey=True).ndim == 2
+
+
+def test_cmu_aerial_and_phone(imu_root):
+    aerial = load_recording(imu_root / "cmu_hwangbo_aerial")
+    assert len(aerial) == 441 and aerial.gt_boxes is None and aerial.camera.width == 320
+    phone = load_recording(imu_root / "phone_gyrostab_20200109_145447")
+    assert len(phone) == 103 and phone.frame_files[0].name == "RE_frame-99.jpg"
+    assert phone.frame_stamps_ns[0] == 4_328_043_690_897_000         # exact decimal parse
+    assert phone.imu_t_ns[0] == 4_328_040_426_741_000
+    assert phone.time_offset_ns == 13_000_000 and not phone.camera.has_distortion
+    assert phone.gyro.shape == (29466, 3)
+
+
+def test_gt_file_parsing(tmp_path):
+    p = tmp_path / "gt.txt"
+    p.write_text("10,20,30,40,ok\nNaN,NaN,NaN,NaN,absent\n1.5,2,3,4\n5,6,7,8,absent\n")
+    boxes, flags = load_gt_boxes(p)
+    np.testing.assert_allclose(boxes[0], [9, 19, 30, 40])
+    assert np.isnan(boxes[1]).all() and np.isnan(boxes[3]).all()
+    np.testing.assert_allclose(boxes[2], [0.5, 1, 3, 4])
+    assert list(flags) == ["ok", "absent", "ok", "absent"]
+    p.write_text("1,2,x,4\n")
+    with pytest.raises(ValueError, match="bad box line"):
+        load_gt_boxes(p)
+
+
+def test_bad_folder(tmp_path):
+    with pytest.raises(ValueError, match="not a recording folder"):
+        load_recording(tmp_path / "missing")
+    with pytest.raises(ValueError, match="neither a CMU recording"):
+        load_recording(tmp_path)
+    (tmp_path / "x_img.log").write_text("x_img\nx_00000001_00000100.jpg\n")
+    with pytest.raises(ValueError, match="recording file missing"):
+        load_recording(tmp_path)

@@ -1,0 +1,106 @@
+"""Sparse codes (eq. lagrange), max-alignment pooling and the kernel weights (section 4)."""
+import numpy as np
+import pytest
+
+from iemd_ros.histogram import candidate_weights, epanechnikov, target_weights
+from iemd_ros.sparse_coding import SparseCoder, lasso_objective, max_alignment_pooling
+
+
+def patch_dictionary(seed=0, dim=64, n_atoms=147, n_signals=40):
+    """Zero-mean unit-norm patches with the strong coherence of real template patches."""
+    rng = np.random.default_rng(seed)
+    base = rng.normal(size=(dim, n_atoms // 3))
+    atoms = np.hstack([base + 0.3 * rng.normal(size=base.shape) for _ in range(3)])
+    atoms -= atoms.mean(0)
+    atoms /= np.linalg.norm(atoms, axis=0)
+    signals = atoms[:, rng.integers(0, n_atoms, n_signals)] * rng.uniform(0.5, 1.5, n_signals)
+    signals += 0.2 * rng.normal(size=signals.shape)
+    return atoms, signals
+
+
+def kkt_residual(atoms, signals, codes, lam):
+    """Optimality of min ||e - Phi a||^2 + lam |a|_1, a >= 0: gradient g = 2 Phi'(Phi a - e) + lam
+    must vanish where a > 0 and be >= 0 where a = 0."""
+    g = 2 * atoms.T @ (atoms @ codes - signals) + lam
+    return np.where(codes > 0, np.abs(g), np.maximum(-g, 0)).max()
+
+
+@pytest.mark.parametrize("lam", [0.01, 0.1, 0.5])
+def test_codes_satisfy_kkt_conditions(lam):
+    atoms, signals = patch_dictionary()
+    codes = SparseCoder(atoms, lam).encode(signals)
+    assert codes.min() >= 0
+    assert kkt_residual(atoms, signals, codes, lam) < 1e-7
+    assert 0 < (codes > 0).sum(0).mean() < 64  # sparse, not empty
+
+
+def test_codes_are_optimal_against_perturbations():
+    atoms, signals = patch_dictionary(seed=1)
+    lam = 0.05
+    codes = SparseCoder(atoms, lam).encode(signals)
+    best = lasso_objective(atoms, signals, codes, lam)
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        other = np.maximum(codes + 0.01 * rng.normal(size=codes.shape), 0)
+        assert np.all(lasso_objective(atoms, signals, other, lam) >= best - 1e-12)
+
+
+def test_warm_start_gives_the_same_codes():
+    atoms, signals = patch_dictionary(seed=2)
+    coder = SparseCoder(atoms, 0.02)
+    cold = coder.encode(signals)
+    perturbed = signals + 0.05 * np.random.default_rng(3).normal(size=signals.shape)
+    expected = coder.encode(perturbed)
+    assert np.allclose(coder.encode(perturbed, warm=cold), expected, atol=1e-10)
+    # Even a poor guess (every atom active) ends at the same optimum.
+    assert np.allclose(coder.encode(perturbed, warm=np.ones_like(cold)), expected, atol=1e-9)
+    with pytest.raises(ValueError, match="warm codes"):
+        coder.encode(signals, warm=cold[:, :3])
+
+
+def test_duplicate_atoms_do_not_break_the_solver():
+    atoms, signals = patch_dictionary(seed=4, n_atoms=30)
+    doubled = np.hstack([atoms, atoms])  # e.g. two identical templates
+    codes = SparseCoder(doubled, 0.05).encode(signals)
+    assert np.all(np.isfinite(codes))
+    assert kkt_residual(doubled, signals, codes, 0.05) < 1e-6
+
+
+def test_max_alignment_pooling_by_hand():
+    # 2 templates x 3 positions, 2 patches.
+    codes = np.array([
+        [0.1, 0.0],  # template 1, position 1
+        [0.0, 0.3],  # template 1, position 2
+        [0.2, 0.0],  # template 1, position 3
+        [0.4, 0.1],  # template 2, position 1
+        [0.0, 0.3],  # template 2, position 2
+        [0.0, 0.0],  # template 2, position 3
+    ])
+    # a_bar = sum over templates per position: patch 1 -> (0.5, 0, 0.2), patch 2 -> (0.1, 0.6, 0)
+    assert np.allclose(max_alignment_pooling(codes, 2), [0.5, 0.6])
+    with pytest.raises(ValueError):
+        max_alignment_pooling(codes, 4)
+
+
+def test_epanechnikov_and_target_weights_by_hand():
+    pos = np.array([[0.0, 0.0], [0.5, 0.0], [0.6, 0.8], [1.0, 1.0]])
+    assert np.allclose(epanechnikov(pos, 1.0), [1.0, 0.75, 0.0, 0.0])
+    assert np.allclose(epanechnikov(pos, 2.0), [1.0, 1 - 0.0625, 0.75, 0.5])
+    w = target_weights(np.array([2.0, 1.0, 5.0, 1.0]), pos, 1.0)
+    assert np.allclose(w, np.array([2.0, 0.75, 0.0, 0.0]) / 2.75)
+    with pytest.raises(ValueError, match="empty"):
+        target_weights(np.zeros(4), pos, 1.0)
+
+
+def test_candidate_weights_jacobian_matches_finite_differences():
+    rng = np.random.default_rng(5)
+    pos = rng.uniform(-1.2, 1.2, (60, 2))
+    q = rng.uniform(0, 1, 60)
+    y, scale = np.array([0.1, -0.05]), 1.02
+    w, dw = candidate_weights(q, pos, y, scale, 1.0)
+    assert w.sum() == pytest.approx(1.0)
+    assert np.allclose(dw.sum(0), 0.0, atol=1e-12)  # normalization is differentiated too
+    h = 1e-7
+    for k, e in enumerate(np.eye(2)):
+        fd = (candidate_weights(q, pos, y + h * e, scale, 1.0)[0] - candidate_weights(q, pos, y - h * e, scale, 1.0)[0]) / (2 * h)
+        assert np.allclose(dw[:, k], fd, atol=1e-6)

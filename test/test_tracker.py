@@ -1,0 +1,155 @@
+"""IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
+import cv2
+import numpy as np
+import pytest
+
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.appearance import PatchLayout
+from iemd_ros.metrics import iou
+from iemd_ros.otb import load_sequence, read_frame
+from iemd_ros.template import TemplateDictionary
+
+
+def texture(seed=0, shape=(240, 320), blob=5):
+    rng = np.random.default_rng(seed)
+    noise = rng.uniform(0, 255, (shape[0] // blob, shape[1] // blob)).astype(np.float32)
+    return np.clip(cv2.resize(noise, (shape[1], shape[0]), interpolation=cv2.INTER_CUBIC), 0, 255).astype(np.uint8)
+
+
+def shifted(img, dx, dy):
+    m = np.float32([[1, 0, dx], [0, 1, dy]])
+    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
+
+
+@pytest.mark.parametrize("bad,match", [
+    (np.zeros((0, 10), np.uint8), "empty"),
+    (np.zeros((10, 10), np.float32), "uint8"),
+    (np.zeros((10, 10, 4), np.uint8), "HxW"),
+    ([[1, 2], [3, 4]], "numpy"),
+])
+def test_invalid_frames_raise_value_error(bad, match):
+    with pytest.raises(ValueError, match=match):
+        IemdTracker().init(bad, (1, 1, 4, 4))
+
+
+@pytest.mark.parametrize("box,match", [
+    ((10, 10, 0, 5), "positive size"),
+    ((10, 10, 5, -1), "positive size"),
+    ((400, 10, 20, 20), "outside"),
+    ((-50, 10, 20, 20), "outside"),
+    ((np.nan, 10, 20, 20), "non-finite"),
+    ((1, 2, 3), "4 numbers"),
+])
+def test_invalid_boxes_raise_value_error(box, match):
+    with pytest.raises(ValueError, match=match):
+        IemdTracker().init(texture(), box)
+
+
+def test_invalid_prior_and_call_order():
+    frame = texture()
+    tracker = IemdTracker()
+    with pytest.raises(RuntimeError, match="before init"):
+        tracker.update(frame)
+    tracker.init(frame, (100, 80, 40, 40))
+    for prior, match in [(np.eye(2), "3x3"), (np.full((3, 3), np.nan), "non-finite"), (np.zeros((3, 3)), "singular")]:
+        with pytest.raises(ValueError, match=match):
+            tracker.update(frame, prior=prior)
+
+
+def test_invalid_config_is_rejected():
+    for kwargs in [dict(alpha=1.5), dict(lam=0), dict(gradient="newton"), dict(patch_size=(40, 40)),
+                   dict(scale_step=0.7)]:
+        with pytest.raises(ValueError):
+            TrackerConfig(**kwargs)
+    with pytest.raises(ValueError, match="unknown tracker parameters: bogus"):
+        TrackerConfig.from_dict({"bogus": 1})
+
+
+@pytest.mark.parametrize("dx,dy", [(2.4, -1.7), (-2.6, 0.8), (0.6, 2.3)])
+def test_recovers_a_known_subpixel_translation_of_a_texture(dx, dy):
+    frame0 = texture(seed=1, blob=8)
+    box = (130.0, 90.0, 48.0, 40.0)
+    tracker = IemdTracker(TrackerConfig(scale_step=0, update_templates=False))
+    tracker.init(frame0, box)
+    result = tracker.update(shifted(frame0, dx, dy))
+    assert not result.lost
+    assert abs(result.box[0] - (box[0] + dx)) < 0.5 and abs(result.box[1] - (box[1] + dy)) < 0.5, result.box
+
+
+def test_recovers_a_translation_of_a_real_texture(otb_root):
+    seq = load_sequence(otb_root / "Car4")
+    frame0 = read_frame(seq.frame_paths[0])
+    x, y, w, h = seq.gt_boxes[0]
+    tracker = IemdTracker(TrackerConfig(scale_step=0, update_templates=False))
+    tracker.init(frame0, (x, y, w, h))
+    result = tracker.update(shifted(frame0, 3.3, -2.2))
+    assert abs(result.box[0] - (x + 3.3)) < 0.75 and abs(result.box[1] - (y - 2.2)) < 0.75, result.box
+
+
+def test_prior_moves_the_start_of_the_search():
+    """A 25 px jump is outside the convergence region; the right prior brings it back."""
+    frame0 = texture(seed=2)
+    box = (130.0, 90.0, 40.0, 40.0)
+    frame1 = shifted(frame0, 25.0, 0.0)
+    config = TrackerConfig(scale_step=0, n_particles=0, update_templates=False)
+    without = IemdTracker(config)
+    without.init(frame0, box)
+    with_prior = IemdTracker(config)
+    with_prior.init(frame0, box)
+    H = np.array([[1, 0, 25.0], [0, 1, 0], [0, 0, 1]])
+    r_prior = with_prior.update(frame1, prior=H)
+    r_plain = without.update(frame1)
+    assert abs(r_prior.box[0] - 155.0) < 0.5
+    assert abs(r_plain.box[0] - 155.0) > 5.0
+    assert r_prior.predicted_box[0] == pytest.approx(155.0)
+
+
+def test_target_leaving_the_image_is_reported_lost():
+    frame = texture(seed=3)
+    tracker = IemdTracker()
+    tracker.init(frame, (2.0, 100.0, 40.0, 40.0))
+    H = np.array([[1, 0, -60.0], [0, 1, 0], [0, 0, 1]])  # the camera says it moved off the left edge
+    result = tracker.update(frame, prior=H)
+    assert result.lost and "inside the image" in result.reason
+
+
+def test_reconstructed_template_removes_an_occluder():
+    """Eq. (reconstructed template): occluded pixels go to the trivial templates."""
+    layout = PatchLayout((32, 32), (8, 8), 4)
+    rng = np.random.default_rng(0)
+    base = rng.uniform(0.2, 0.8, (32, 32))
+    d = TemplateDictionary(layout, n_templates=2, lam=0.01, forgetting=0.95, reconstruction_lambda=0.1)
+    d.add(base, 0.0, 0)
+    d.add(np.clip(base + 0.05 * rng.normal(size=base.shape), 0, 1), 0.0, 1)
+    occluded = base.copy()
+    occluded[8:20, 8:20] = 1.0
+    recon = d.reconstruct(occluded)
+    assert np.abs(recon - base)[8:20, 8:20].mean() < 0.3 * np.abs(occluded - base)[8:20, 8:20].mean()
+
+
+def test_template_update_rule():
+    """Algorithm 2: the latest template is replaced only when the current one outweighs its decayed weight."""
+    layout = PatchLayout((32, 32), (8, 8), 4)
+    rng = np.random.default_rng(1)
+    d = TemplateDictionary(layout, n_templates=2, lam=0.01, forgetting=0.9, reconstruction_lambda=0.1)
+    t0 = rng.uniform(0, 1, (32, 32))
+    d.add(t0, 0.0, 0)
+    assert d.observe(t0, 0.2, 1)  # fills the second slot
+    assert d.full and d.latest_weight == pytest.approx(np.exp(-0.2))
+    # One frame later: exp(-0.5) < 0.9 * exp(-0.2): a worse match does not replace it.
+    assert not d.observe(t0, 0.5, 2)
+    # Ten frames later the old weight has decayed: 0.9**9 * exp(-0.2) < exp(-0.5).
+    assert d.observe(t0, 0.5, 10)
+    assert d.latest_index == 10
+
+
+def test_tracks_a_real_otb_excerpt(otb_root):
+    """Car4 frames 1-80 (illumination change under trees): average overlap > 0.7."""
+    seq = load_sequence(otb_root / "Car4")
+    tracker = IemdTracker()
+    tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
+    boxes = [seq.gt_boxes[0]]
+    for path in seq.frame_paths[1:80]:
+        boxes.append(tracker.update(read_frame(path)).box)
+    overlap = iou(np.array(boxes), seq.gt_boxes[:80])
+    assert overlap.mean() > 0.7, overlap.mean()
