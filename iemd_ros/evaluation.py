@@ -73,10 +73,10 @@ class OpenCVTracker:
 class IemdAdapter:
     """Adapter for :class:`iemd_ros.IemdTracker` (imported lazily; no gyro prior in OTB)."""
 
-    def __init__(self):
+    def __init__(self, config=None):
         from iemd_ros import IemdTracker  # noqa: PLC0415 - lazy: optional while the tracker is written
 
-        self._tracker = IemdTracker()
+        self._tracker = IemdTracker(config)
 
     def init(self, frame: np.ndarray, box: np.ndarray) -> None:
         self._tracker.init(frame, tuple(float(v) for v in box))

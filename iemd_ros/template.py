@@ -70,14 +70,19 @@ class TemplateDictionary:
         return True
 
     def reconstruct(self, template: np.ndarray) -> np.ndarray:
-        """Reconstructed template Phi_T a* of eq. (reconstructed template).
+        """Reconstructed template of eq. (reconstructed template), occluders removed.
 
         Solves min ||I_k - [Phi_T I] a||^2 + lambda ||a||_1 with a >= 0 on the
         template part and a free sign on the trivial (identity) part, by block
-        coordinate descent: the trivial part has the closed form of soft
+        coordinate descent: the trivial part e has the closed form of soft
         thresholding the residual at lambda/2, the template part is a small
-        non-negative lasso over the L whole templates.  Occluded or noisy pixels
-        go to the trivial part and are left out of the reconstruction.
+        non-negative lasso over the L whole templates.
+        Returned: I_k - e, i.e. the observed template where the trivial templates
+        claim nothing and Phi_T a* (+- lambda/2) where they do (occluders, noise).
+        The paper keeps Phi_T a* alone; but that only recombines the templates
+        already in the dictionary, so the dictionary could never take in a new
+        appearance (lighting, pose).  Keeping the unclaimed observed pixels does,
+        while an occluder is still replaced by what the dictionary predicts.
         """
         x = np.asarray(template, dtype=np.float64).ravel()
         if not self.templates:
@@ -86,12 +91,12 @@ class TemplateDictionary:
         coder = SparseCoder(phi_t, self.reconstruction_lambda)
         half = 0.5 * self.reconstruction_lambda
         trivial = np.zeros_like(x)
-        codes = np.zeros(phi_t.shape[1])
         for _ in range(20):
             codes = coder.encode((x - trivial)[:, None])[:, 0]
             residual = x - phi_t @ codes
             new_trivial = np.sign(residual) * np.maximum(np.abs(residual) - half, 0.0)
             if np.max(np.abs(new_trivial - trivial)) < 1e-6:
+                trivial = new_trivial
                 break
             trivial = new_trivial
-        return (phi_t @ codes).reshape(template.shape)
+        return (x - trivial).reshape(template.shape)

@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+"""Compare IemdTracker configurations on OTB sequences: average overlap and EMD discrimination.
+
+    python benchmarks/tune_tracker.py --sequences Car4,Bolt2,Woman \
+        --config "{}" --config "{'normalization': 'l2'}" [--frames N] [--discrimination]
+
+Average overlap is the paper's metric over the whole sequence (or its first N
+frames).  ``--discrimination`` also reports, on a few frames per sequence, the
+percentage of windows within +-40 px of the ground truth (but away from it)
+whose EMD is *lower* than the EMD at the ground truth, for a tracker
+initialized on frame 1 without updates: 0 % means the EMD singles out the
+target, 100 % means everything else looks more like it.
+"""
+from __future__ import annotations
+
+import argparse
+import ast
+from multiprocessing import Pool
+
+import numpy as np
+
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.appearance import ImagePyramid, to_gray
+from iemd_ros.evaluation import IemdAdapter, run_tracker
+from iemd_ros.metrics import average_overlap, iou
+from iemd_ros.otb import default_root, load_sequence, read_frame
+
+
+def overlap(job):
+    name, config, frames = job
+    seq = load_sequence(name, default_root())
+    if frames:
+        seq = seq.head(frames)
+    adapter = IemdAdapter(TrackerConfig(**config))
+    run = run_tracker(adapter, seq.frames(), seq.gt_boxes[0])
+    return average_overlap(iou(run.boxes, seq.gt_boxes)), float(np.median(run.update_seconds) * 1e3)
+
+
+def discrimination(job, radius=40, grid=4):
+    name, config, _ = job
+    seq = load_sequence(name, default_root())
+    tracker = IemdTracker(TrackerConfig(**config))
+    tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
+    picks = np.linspace(10, len(seq) - 1, 5).astype(int)
+    scores = []
+    for k in picks:
+        pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
+        x, y, w, h = seq.gt_boxes[k]
+        center, size = np.array([x + (w - 1) / 2, y + (h - 1) / 2]), np.array([w, h])
+        at_gt = tracker._evaluate(tracker._candidate(pyramid, center, size))[0]
+        others = [tracker._evaluate(tracker._candidate(pyramid, center + (dx, dy), size))[0]
+                  for dy in range(-radius, radius + 1, grid) for dx in range(-radius, radius + 1, grid)
+                  if abs(dx) >= 0.3 * w or abs(dy) >= 0.3 * h]
+        scores.append(100.0 * np.mean(np.array(others) < at_gt))
+    return scores
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sequences", default="Car4,Bolt2,Woman")
+    parser.add_argument("--config", action="append", default=[], help="TrackerConfig overrides as a dict literal")
+    parser.add_argument("--frames", type=int, default=0, help="first N frames only (0: all)")
+    parser.add_argument("--discrimination", action="store_true")
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args()
+    configs = [ast.literal_eval(c) for c in (args.config or ["{}"])]
+    names = args.sequences.split(",")
+    jobs = [(n, c, args.frames) for c in configs for n in names]
+    with Pool(args.jobs) as pool:
+        results = pool.map(overlap, jobs)
+        disc = pool.map(discrimination, jobs) if args.discrimination else None
+    for ci, config in enumerate(configs):
+        rows = results[ci * len(names):(ci + 1) * len(names)]
+        cells = " ".join(f"{n}={ao * 100:5.1f}%" for n, (ao, _) in zip(names, rows))
+        speed = np.median([ms for _, ms in rows])
+        line = f"{str(config):70s} {cells}  mean={np.mean([r[0] for r in rows]) * 100:5.1f}%  median update {speed:.1f} ms"
+        if disc:
+            d = disc[ci * len(names):(ci + 1) * len(names)]
+            line += "  discrimination " + " ".join(f"{n}={np.mean(s):.0f}%" for n, s in zip(names, d))
+        print(line, flush=True)
+
+
+if __name__ == "__main__":
+    main()
