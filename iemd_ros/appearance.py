@@ -41,27 +41,25 @@ class ImagePyramid:
     def shape(self) -> tuple[int, int]:
         return self.levels[0].shape
 
-    def sample(self, center, size, template_size, origin=(0, 0), out_size=None) -> np.ndarray:
-        """Resample a window to template pixels.
+    def sample(self, center, size, template_size, coarse: int = 0) -> np.ndarray:
+        """Resample a window to a (Th, Tw) template; ``template_size`` is (Tw, Th).
 
-        ``template_size`` is (Tw, Th).  By default the whole window is returned as
-        a (Th, Tw) array; ``origin`` (template pixels, may be negative) and
-        ``out_size`` (width, height) select another region of the same template
-        lattice, e.g. patches around the window.  Parts outside the image are
-        padded by replicating the border.
+        ``coarse`` samples that many pyramid levels above the anti-aliasing level:
+        a smoother template of the same window, for the coarse stage of the
+        search.  Parts outside the image are padded by replicating the border.
         """
         tw, th = template_size
-        out_w, out_h = out_size if out_size is not None else template_size
         sx, sy = size[0] / tw, size[1] / th
-        level = int(np.clip(np.floor(np.log2(max(min(sx, sy), 1.0))), 0, len(self.levels) - 1))
+        level = int(np.floor(np.log2(max(min(sx, sy), 1.0)))) + coarse
+        level = int(np.clip(level, 0, len(self.levels) - 1))
         f = 2.0**level
         # Image point of template pixel u: cx + (u - (Tw-1)/2) * sx; at level l a
         # full-resolution coordinate x sits at (x + 0.5) / 2^l - 0.5.
-        ox = (center[0] + (origin[0] - (tw - 1) / 2) * sx + 0.5) / f - 0.5
-        oy = (center[1] + (origin[1] - (th - 1) / 2) * sy + 0.5) / f - 0.5
+        ox = (center[0] - (tw - 1) / 2 * sx + 0.5) / f - 0.5
+        oy = (center[1] - (th - 1) / 2 * sy + 0.5) / f - 0.5
         warp = np.array([[sx / f, 0.0, ox], [0.0, sy / f, oy]], dtype=np.float64)
         return cv2.warpAffine(
-            self.levels[level], warp, (int(out_w), int(out_h)),
+            self.levels[level], warp, (int(tw), int(th)),
             flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE,
         )
 
@@ -95,7 +93,7 @@ class PatchLayout:
         pw, ph = self.patch_size
         return (tw - pw) // self.step + 1, (th - ph) // self.step + 1
 
-    def cell_positions(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    def cell_positions(self, i, j) -> np.ndarray:
         """(N, 2) normalized centres of lattice cells (i, j): patch top-left at (i, j) * step.
 
         Cells 0..cells-1 are the window's own patches; other integers continue the

@@ -25,18 +25,22 @@ from .sparse_coding import SparseCoder, max_alignment_pooling
 class CandidateModel:
     """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``."""
 
-    def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, coder: SparseCoder,
-                 n_templates: int, target_eps: np.ndarray, alpha: float, warm: np.ndarray | None = None):
+    def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, coder: SparseCoder | None,
+                 n_templates: int, target_eps: np.ndarray, alpha: float, warm: np.ndarray | None = None,
+                 coarse: int = 0):
+        """``coder=None`` (the coarse stage) gives every patch code weight 1: only the kernel weights bins."""
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
         self.alpha = alpha
-        template = pyramid.sample(self.center, self.size, layout.template_size)
+        template = pyramid.sample(self.center, self.size, layout.template_size, coarse)
         self.eps, jac = layout.extract_with_jacobian(template)
         # d epsilon / d (window centre in image pixels): template pixels per image pixel.
         self.eps_jacobian = jac * (np.asarray(layout.template_size, dtype=np.float64) / self.size)
         self.pos = layout.positions()
-        self.codes = coder.encode(self.eps.T, warm=warm)
-        self.code_weights = max_alignment_pooling(self.codes, n_templates)
+        if coder is None:
+            self.code_weights = np.ones(len(self.eps))
+        else:
+            self.code_weights = max_alignment_pooling(coder.encode(self.eps.T, warm=warm), n_templates)
         self.appearance_cost = alpha * appearance_distance(target_eps, self.eps)
 
     def evaluate(self, y, bandwidth: float, target_pos, target_eps, target_weights, gradient: str):
