@@ -1,0 +1,145 @@
+"""ROS message fields <-> numpy, without rclpy or cv_bridge.
+
+The functions take plain message *fields*, so ``rclpy`` messages (``data`` is an ``array.array`` or
+``bytes``), ``rosbags`` messages (``data`` is a numpy array) and hand-made values all work:
+
+    frame = image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, msg.is_bigendian)
+    camera = camera_model_from_info(msg.k, msg.d, msg.distortion_model, msg.width, msg.height)
+
+Pixel data is reinterpreted with ``np.frombuffer`` (no per-element Python loop); the returned frame
+is what :class:`iemd_ros.IemdTracker` takes: ``HxW`` uint8 (grey) or ``HxWx3`` uint8 BGR.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .camera import CameraModel
+from .gyro import box_centre
+
+__all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "camera_model_from_info", "stamp_to_ns",
+           "ns_to_stamp", "box_to_bbox", "bbox_to_box"]
+
+# encoding -> (channels, bytes per channel)
+ENCODINGS = {"mono8": (1, 1), "mono16": (1, 2), "bgr8": (3, 1), "rgb8": (3, 1), "bgra8": (4, 1), "rgba8": (4, 1)}
+
+
+def _as_bytes(data) -> memoryview:
+    """A flat byte view of ``data`` (bytes, bytearray, array.array, numpy array, list of ints)."""
+    if isinstance(data, np.ndarray):
+        return memoryview(np.ascontiguousarray(data).view(np.uint8).reshape(-1))
+    if isinstance(data, (list, tuple)):                 # rare: a hand-made message
+        return memoryview(np.asarray(data, dtype=np.uint8))
+    try:
+        return memoryview(data).cast("B")
+    except TypeError as exc:
+        raise ValueError(f"image data must be bytes-like, got {type(data).__name__}") from exc
+
+
+def image_to_array(encoding: str, height: int, width: int, step: int, data, is_bigendian: bool = False) -> np.ndarray:
+    """``sensor_msgs/Image`` fields -> tracker frame (``HxW`` uint8 or ``HxWx3`` uint8 BGR).
+
+    mono8/bgr8 are returned as views of ``data`` when the rows are unpadded; rgb8/bgra8/rgba8 are
+    converted to BGR (alpha dropped).  mono16 (either byte order) is reduced to 8 bits by the right
+    shift that puts the frame's highest set bit at bit 7 (a 12-bit sensor in mono16 keeps its 8 most
+    significant *used* bits instead of turning almost black under a fixed ``>> 8``; the shift only
+    changes when the frame maximum crosses a power of two, and the tracker normalizes the grey
+    levels of its window anyway).  Raises ValueError on an unknown encoding, a ``step`` shorter than
+    a row or a ``data`` size other than ``step * height``.
+    """
+    if encoding not in ENCODINGS:
+        raise ValueError(f"unsupported image encoding {encoding!r}: expected one of {', '.join(ENCODINGS)}")
+    height, width, step = int(height), int(width), int(step)
+    if height <= 0 or width <= 0:
+        raise ValueError(f"image is empty: {width}x{height}")
+    channels, depth = ENCODINGS[encoding]
+    row = width * channels * depth
+    if step < row:
+        raise ValueError(f"step {step} is shorter than one {encoding} row of {width} px ({row} bytes)")
+    buf = _as_bytes(data)
+    if len(buf) != step * height:
+        raise ValueError(f"image data has {len(buf)} bytes, expected step*height = {step}*{height} = {step * height}")
+    raw = np.frombuffer(buf, dtype=np.uint8).reshape(height, step)[:, :row]
+    if depth == 2:
+        mono = raw.view(">u2" if is_bigendian else "<u2").reshape(height, width)
+        shift = max(0, int(mono.max()).bit_length() - 8)
+        return (mono >> shift).astype(np.uint8)
+    pix = raw.reshape(height, width, channels) if channels > 1 else raw
+    if encoding in ("mono8", "bgr8"):
+        return pix
+    if encoding == "rgb8":
+        return np.ascontiguousarray(pix[..., ::-1])
+    if encoding == "bgra8":
+        return np.ascontiguousarray(pix[..., :3])
+    return np.ascontiguousarray(pix[..., 2::-1])      # rgba8
+
+
+def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dict:
+    """Tracker frame -> ``sensor_msgs/Image`` fields (``data`` as ``bytes``, the fast path for rclpy).
+
+    ``encoding`` defaults to mono8 for ``HxW`` and bgr8 for ``HxWx3`` uint8 frames; rgb8 flips the
+    channels.  Assign the fields one by one (``msg.data = fields['data']``): a ``bytes`` value is
+    copied in about 0.06 ms where a numpy array costs ~68 ms per 640x480x3 frame.
+    """
+    frame = np.asarray(frame)
+    if frame.dtype != np.uint8 or frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
+        raise ValueError(f"frame must be HxW or HxWx3 uint8, got {frame.dtype} {frame.shape}")
+    default = "mono8" if frame.ndim == 2 else "bgr8"
+    encoding = default if encoding is None else encoding
+    if encoding not in (default, "rgb8" if frame.ndim == 3 else default):
+        raise ValueError(f"cannot write a {frame.shape} frame as {encoding!r}")
+    if encoding == "rgb8":
+        frame = frame[..., ::-1]
+    h, w = frame.shape[:2]
+    channels = 1 if frame.ndim == 2 else 3
+    return dict(encoding=encoding, height=h, width=w, step=w * channels, is_bigendian=0,
+                data=np.ascontiguousarray(frame).tobytes())
+
+
+def camera_model_from_info(k, d, distortion_model: str, width: int, height: int) -> CameraModel:
+    """``sensor_msgs/CameraInfo`` fields -> :class:`~iemd_ros.camera.CameraModel` (K and plumb_bob D).
+
+    An all-zero ``k`` (an uncalibrated driver) and non-plumb_bob models with non-zero coefficients
+    raise ValueError saying so.
+    """
+    K = np.asarray(k, dtype=float).ravel()
+    if K.shape != (9,):
+        raise ValueError(f"camera_info k must have 9 values, got {K.size}")
+    if not np.any(K):
+        raise ValueError("camera_info k is all zero: the camera is not calibrated")
+    D = np.asarray(d, dtype=float).ravel()
+    w, h = int(width), int(height)
+    return CameraModel.from_camera_info(dict(k=K, d=D, distortion_model=distortion_model or "plumb_bob",
+                                             width=w if w > 0 else None, height=h if h > 0 else None))
+
+
+def stamp_to_ns(sec: int, nanosec: int) -> int:
+    """``builtin_interfaces/Time`` -> integer nanoseconds."""
+    return int(sec) * 1_000_000_000 + int(nanosec)
+
+
+def ns_to_stamp(t_ns: int) -> tuple[int, int]:
+    """Integer nanoseconds -> ``(sec, nanosec)`` with ``0 <= nanosec < 1e9``."""
+    sec, nsec = divmod(int(t_ns), 1_000_000_000)
+    return sec, nsec
+
+
+def box_to_bbox(box) -> tuple[float, float, float, float]:
+    """Tracker box ``(x, y, w, h)`` -> ``vision_msgs/BoundingBox2D`` ``(center_x, center_y, size_x, size_y)``.
+
+    The centre is in pixel-index coordinates (pixel centres at integers, as ``K``):
+    ``x + (w - 1) / 2`` (:func:`iemd_ros.gyro.box_centre`); the size is ``w, h`` pixels.
+    """
+    b = np.asarray(box, dtype=float).ravel()
+    if b.shape != (4,):
+        raise ValueError(f"box must be (x, y, w, h), got {np.asarray(box).tolist()}")
+    cx, cy = box_centre(b)
+    return float(cx), float(cy), float(b[2]), float(b[3])
+
+
+def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) -> tuple[float, float, float, float]:
+    """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size."""
+    v = np.array([center_x, center_y, size_x, size_y], dtype=float)
+    if not np.all(np.isfinite(v)) or v[2] <= 0 or v[3] <= 0:
+        raise ValueError(f"bounding box needs a finite centre and a positive size, got centre ({center_x}, "
+                         f"{center_y}), size {size_x} x {size_y}")
+    return (float(v[0] - (v[2] - 1) / 2), float(v[1] - (v[3] - 1) / 2), float(v[2]), float(v[3]))

@@ -1,0 +1,618 @@
+"""Message-level tracking pipeline (ROS-free): images, gyro and camera info in, tracked boxes out.
+
+The one place where per-message data flows into :class:`~iemd_ros.IemdTracker` and
+:class:`~iemd_ros.gyro.GyroPredictor`; used by the ROS node (:mod:`iemd_ros.node`) and by the bag
+replay, so both produce the same boxes from the same messages:
+
+    pipe = TrackingPipeline(PipelineConfig())
+    pipe.set_camera(camera)                      # from CameraInfo (conversions.camera_model_from_info)
+    pipe.add_imu(t_ns, (wx, wy, wz))             # every Imu message (IMU frame, rad/s)
+    pipe.init(frame, (x, y, w, h), t_ns)         # start (or restart) on a frame
+    if pipe.gyro_ready(t_ns) or waited_long_enough:
+        result = pipe.process(frame, t_ns)       # FrameResult
+    pipe.statuses()                              # OK/WARN/ERROR summaries for /diagnostics
+
+Gyro prior (paper, section 5.2): the rotation is integrated from the frame whose window the tracker
+holds -- the init frame or the last frame that was not lost (a lost frame leaves the window where it
+was) -- to the new frame, and the lens-aware ``K R^T K^-1`` prior is fitted at that window.
+
+Everything that decides a result depends only on the messages (stamps and contents), never on the
+wall clock, so replaying the same messages twice gives identical results; only
+``FrameResult.processing_ms`` and the ``*_ms`` diagnostic values are wall-clock measurements.
+Waiting for IMU coverage is the caller's choice: :meth:`TrackingPipeline.gyro_ready` says whether a
+frame would get a prior now; a live node waits up to ``imu_wait_ms`` of wall time, an offline
+replay can read ahead in the bag.
+
+Thread safety: :meth:`add_imu`, :meth:`set_camera` and the ``note_*`` methods may be called from
+other threads while :meth:`process` runs; they never wait for a tracker update to finish.
+"""
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections import deque
+from dataclasses import asdict, dataclass, field, fields, replace
+
+import numpy as np
+
+from .camera import CameraModel
+from .gyro import GyroConfig, GyroPredictor
+from .tracker import IemdTracker, TrackerConfig
+
+__all__ = ["PipelineConfig", "FrameResult", "Status", "TrackingPipeline", "OK", "WARN", "ERROR",
+           "gyro_config_from_dict", "gyro_config_to_dict"]
+
+# levels of diagnostic_msgs/DiagnosticStatus
+OK, WARN, ERROR = 0, 1, 2
+
+_WINDOW = 30            # recent frames / IMU messages the statuses look at
+_LOST_ERROR_FRAMES = 30  # lost this many frames in a row: ERROR
+_IMU_ERROR_RUN = 10      # this many rejected IMU messages in a row: ERROR
+_PROBE_CAMERA = CameraModel(np.eye(3))
+
+
+def gyro_config_from_dict(values: dict) -> GyroConfig:
+    """GyroConfig from plain values (lists for ``R_cam_imu`` (9 or 3x3) and ``bias``; ``saturation``
+    <= 0 or None means no limit).  Raises ValueError on unknown keys or invalid values."""
+    known = {f.name for f in fields(GyroConfig)}
+    unknown = set(values) - known
+    if unknown:
+        raise ValueError(f"unknown gyro parameters: {', '.join(sorted(unknown))}")
+    v = dict(values)
+    if v.get("R_cam_imu") is not None:
+        R = np.asarray(v["R_cam_imu"], dtype=float)
+        if R.size != 9:
+            raise ValueError(f"gyro R_cam_imu must have 9 values (row-major 3x3), got {R.size}")
+        v["R_cam_imu"] = R.reshape(3, 3)
+    if v.get("bias") is not None:
+        v["bias"] = np.asarray(v["bias"], dtype=float)
+    if v.get("saturation") is not None and float(v["saturation"]) <= 0:
+        v["saturation"] = None
+    for key in ("time_offset_ns", "still_bias_samples", "max_gap_ns", "buffer_ns", "buffer_samples"):
+        if key in v:
+            if float(v[key]) != int(v[key]):
+                raise ValueError(f"gyro {key} must be an integer, got {v[key]!r}")
+            v[key] = int(v[key])
+    cfg = GyroConfig(**v)
+    GyroPredictor(_PROBE_CAMERA, cfg)       # the predictor's own checks (rotation, bias, buffer limits)
+    return cfg
+
+
+def gyro_config_to_dict(cfg: GyroConfig) -> dict:
+    """Plain-value form of a GyroConfig (round-trips through :func:`gyro_config_from_dict`)."""
+    d = asdict(cfg)
+    d["R_cam_imu"] = (np.eye(3) if cfg.R_cam_imu is None else np.asarray(cfg.R_cam_imu, float)).ravel().tolist()
+    d["bias"] = (np.zeros(3) if cfg.bias is None else np.asarray(cfg.bias, float)).tolist()
+    d["saturation"] = 0.0 if cfg.saturation is None else float(cfg.saturation)
+    return d
+
+
+@dataclass
+class PipelineConfig:
+    """Tracker + gyro settings and the pipeline's own.
+
+    ``use_gyro``: pass the gyro prior to the tracker.  ``imu_wait_ms``: how long a live caller may
+    hold a frame for IMU coverage before processing it without the prior.  ``clock_reset_ms``: a
+    stamp this much earlier than the previous one is a clock reset (bag loop, simulation restart):
+    the IMU buffer restarts and tracking goes on without a prior for that frame; smaller steps back
+    reject the frame.  ``score_emd_scale``: detection score ``exp(-EMD / score_emd_scale)``.
+    """
+
+    tracker: TrackerConfig = field(default_factory=TrackerConfig)
+    gyro: GyroConfig = field(default_factory=GyroConfig)
+    use_gyro: bool = True
+    imu_wait_ms: float = 15.0
+    clock_reset_ms: float = 1000.0
+    score_emd_scale: float = 0.25
+
+    def __post_init__(self):
+        if not isinstance(self.tracker, TrackerConfig):
+            raise ValueError("tracker must be a TrackerConfig")
+        if not isinstance(self.gyro, GyroConfig):
+            raise ValueError("gyro must be a GyroConfig")
+        if not (0 <= self.imu_wait_ms <= 1000):
+            raise ValueError(f"imu_wait_ms must be in [0, 1000], got {self.imu_wait_ms}")
+        if not self.clock_reset_ms > 0:
+            raise ValueError(f"clock_reset_ms must be > 0, got {self.clock_reset_ms}")
+        if not self.score_emd_scale > 0:
+            raise ValueError(f"score_emd_scale must be > 0, got {self.score_emd_scale}")
+        self.use_gyro = bool(self.use_gyro)
+
+    @classmethod
+    def from_dict(cls, values: dict) -> "PipelineConfig":
+        """From ``{"tracker": {...}, "gyro": {...}, "use_gyro": ..., ...}`` (missing keys: defaults)."""
+        v = dict(values)
+        unknown = set(v) - {f.name for f in fields(cls)}
+        if unknown:
+            raise ValueError(f"unknown pipeline parameters: {', '.join(sorted(unknown))}")
+        v["tracker"] = TrackerConfig.from_dict(v.get("tracker", {}))
+        v["gyro"] = gyro_config_from_dict(v.get("gyro", {}))
+        return cls(**v)
+
+    def to_dict(self) -> dict:
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        d["tracker"] = self.tracker.to_dict()
+        d["gyro"] = gyro_config_to_dict(self.gyro)
+        return d
+
+
+@dataclass
+class FrameResult:
+    """Outcome of one frame.
+
+    ``state``: "tracking", "lost" or "uninitialized"; ``rejected``: why the frame was not processed
+    ("" when it was).  ``box``/``emd``/``iterations``/``reason`` come from the tracker (``box`` is the
+    best window searched, also when lost); ``score`` = ``exp(-emd / score_emd_scale)`` while
+    tracking, else 0.  ``gyro_box``: the gyro's predicted window; ``predicted_box``: the tracker's
+    starting window (gyro prior + constant velocity).  ``processing_ms`` is wall-clock time.
+    """
+
+    stamp_ns: int
+    state: str
+    box: tuple | None = None
+    emd: float = math.nan
+    score: float = 0.0
+    iterations: int = 0
+    lost: bool = False
+    reason: str = ""
+    rejected: str = ""
+    gyro_used: bool = False
+    gyro_reason: str = ""
+    gyro_box: tuple | None = None
+    predicted_box: tuple | None = None
+    scale: float = 1.0
+    starts: int = 0
+    processing_ms: float = 0.0
+
+    @property
+    def tracking(self) -> bool:
+        return self.state == "tracking" and not self.rejected
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class Status:
+    """One diagnostic status (levels as diagnostic_msgs: OK 0, WARN 1, ERROR 2)."""
+
+    name: str
+    level: int
+    message: str
+    values: dict
+
+
+def _ms(ns: float) -> str:
+    return f"{ns / 1e6:.1f} ms"
+
+
+class TrackingPipeline:
+    """Tracker + gyro predictor fed message by message (see the module docstring)."""
+
+    def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
+        self._cfg = config if config is not None else PipelineConfig()
+        if not isinstance(self._cfg, PipelineConfig):
+            raise ValueError("config must be a PipelineConfig")
+        self._lock = threading.RLock()        # IMU / camera / counters (held briefly)
+        self._track_lock = threading.RLock()  # tracker state (held during a tracker update)
+        self._camera: CameraModel | None = None
+        self._predictor: GyroPredictor | None = None
+        self._pending_imu: deque = deque(maxlen=self._cfg.gyro.buffer_samples)  # before camera_info
+        self._tracker: IemdTracker | None = None
+        self._state = "uninitialized"
+        self._ref: tuple[int, tuple, np.ndarray] | None = None   # (stamp, window box, frame) the window is in
+        self._last_stamp: int | None = None
+        self._last_imu_stamp: int | None = None
+        self._lost_run = 0
+        self.counters = dict(frames_received=0, frames_processed=0, frames_uninitialized=0, frames_dropped=0,
+                             frames_rejected=0, images_malformed=0, frames_lost=0, gyro_used=0, gyro_unused=0,
+                             imu_received=0, imu_rejected=0, imu_out_of_order=0, imu_saturated=0,
+                             clock_resets=0, camera_infos=0, camera_infos_rejected=0, inits=0, resets=0)
+        self._last = dict(frame_reason="", gyro_reason="", imu_reason="", image_error="", camera_error="",
+                          drop_reason="")
+        self._last_result: FrameResult | None = None
+        self._image_bad = False          # the latest image message was malformed
+        self._imu_bad_run = 0            # consecutive rejected IMU messages
+        self._recent = deque(maxlen=_WINDOW)     # (stamp, outcome) of received frames
+        self._recent_proc = deque(maxlen=_WINDOW)  # (stamp, processing_ms, gyro_used) of tracked frames
+        if camera is not None:
+            self.set_camera(camera)
+
+    # ------------------------------------------------------------------ configuration
+    @property
+    def config(self) -> PipelineConfig:
+        return self._cfg
+
+    @property
+    def state(self) -> str:
+        return self._state
+
+    @property
+    def camera(self) -> CameraModel | None:
+        return self._camera
+
+    def configure(self, config: PipelineConfig) -> str:
+        """Apply a new configuration; returns a one-line summary of what changed.
+
+        A changed tracker configuration restarts the tracker at its current window on the frame that
+        window belongs to (the template is taken again there); a changed gyro configuration rebuilds
+        the predictor, keeping the buffered IMU samples.
+        """
+        if not isinstance(config, PipelineConfig):
+            raise ValueError("config must be a PipelineConfig")
+        with self._track_lock, self._lock:
+            old, self._cfg = self._cfg, config
+            notes = []
+            if not _same_gyro(config.gyro, old.gyro):
+                self._rebuild_predictor(keep_bias=False)
+                notes.append("gyro predictor rebuilt (IMU samples kept)")
+            if config.tracker != old.tracker:
+                if self._tracker is not None and self._ref is not None:
+                    stamp, box, frame = self._ref
+                    self._tracker = IemdTracker(config.tracker)
+                    self._tracker.init(frame, box)
+                    self._state, self._lost_run = "tracking", 0
+                    notes.append("tracker restarted at its current window")
+                else:
+                    notes.append("tracker configuration stored")
+            return "; ".join(notes) or "no change"
+
+    # ------------------------------------------------------------------ inputs
+    def set_camera(self, camera: CameraModel) -> bool:
+        """Use ``camera`` (K, D) for the gyro prior; returns True when it differs from the current one."""
+        if not isinstance(camera, CameraModel):
+            raise ValueError(f"camera must be a CameraModel, got {type(camera).__name__}")
+        with self._lock:
+            self.counters["camera_infos"] += 1
+            self._last["camera_error"] = ""
+            cur = self._camera
+            if cur is not None and np.array_equal(cur.K, camera.K) and np.array_equal(cur.D, camera.D) \
+                    and (cur.width, cur.height) == (camera.width, camera.height):
+                return False
+            self._camera = camera
+            self._rebuild_predictor(keep_bias=True)
+            return True
+
+    def note_bad_camera_info(self, reason: str) -> None:
+        """Record a CameraInfo message that could not be used (the previous camera, if any, stays)."""
+        with self._lock:
+            self.counters["camera_infos_rejected"] += 1
+            self._last["camera_error"] = reason
+
+    def _rebuild_predictor(self, keep_bias: bool) -> None:
+        """New GyroPredictor for the current camera/gyro config, fed the samples buffered so far."""
+        if self._camera is None:
+            return
+        cfg = self._cfg.gyro
+        old = self._predictor
+        if old is not None:
+            t, w = old.buffer.samples()
+            if keep_bias and old.bias_estimator.done:      # keep a still-start estimate already made
+                cfg = replace(cfg, bias=old.calibration.bias, still_bias_samples=0)
+        elif self._pending_imu:
+            t = np.array([s[0] for s in self._pending_imu], dtype=np.int64)
+            w = np.array([s[1] for s in self._pending_imu], dtype=float)
+            self._pending_imu.clear()
+        else:
+            t = np.zeros(0, np.int64)
+        self._predictor = GyroPredictor(self._camera, cfg)
+        if len(t):
+            self._predictor.add_imu(t, w)
+
+    def add_imu(self, t_ns: int, gyro_xyz) -> bool:
+        """Add one gyro sample (IMU clock, ns; IMU-frame rate in rad/s).  Returns False if rejected.
+
+        Non-finite rates and saturated samples are rejected and counted; a stamp earlier than the
+        previous one is counted (the buffer puts it in order) and, if earlier by more than
+        ``clock_reset_ms``, restarts the IMU buffer (a clock reset).  ``last_reasons()['imu_reason']``
+        says why.
+        """
+        w = np.asarray(gyro_xyz, dtype=float).ravel()
+        t = int(t_ns)
+        with self._lock:
+            c = self.counters
+            c["imu_received"] += 1
+            if w.shape != (3,) or not np.all(np.isfinite(w)):
+                c["imu_rejected"] += 1
+                self._imu_bad_run += 1
+                self._last["imu_reason"] = (f"IMU sample at {t} ns rejected: angular velocity {w.tolist()} "
+                                            "is not 3 finite values")
+                return False
+            prev = self._last_imu_stamp
+            if prev is not None and t <= prev:
+                back = prev - t
+                if back > self._cfg.clock_reset_ms * 1e6:
+                    c["clock_resets"] += 1
+                    self._last["imu_reason"] = f"IMU clock jumped back by {_ms(back)}: IMU buffer restarted"
+                    self._clear_imu()
+                elif back > 0:
+                    c["imu_out_of_order"] += 1
+                    self._last["imu_reason"] = f"IMU stamp went back by {_ms(back)} (sample put in order)"
+            if self._last_imu_stamp is None or t > self._last_imu_stamp:
+                self._last_imu_stamp = t
+            if self._predictor is None:
+                self._pending_imu.append((t, w))
+                self._imu_bad_run = 0
+                return True
+            if self._predictor.add_imu(t, w) == 0:
+                c["imu_saturated"] += 1
+                self._imu_bad_run += 1
+                self._last["imu_reason"] = (f"IMU sample at {t} ns rejected: |w| reaches the saturation limit "
+                                            f"{self._cfg.gyro.saturation} rad/s")
+                return False
+            self._imu_bad_run = 0
+            return True
+
+    def note_bad_imu(self, reason: str) -> None:
+        """Count an IMU message that carries no usable rate (e.g. covariance[0] = -1: no gyro)."""
+        with self._lock:
+            self.counters["imu_received"] += 1
+            self.counters["imu_rejected"] += 1
+            self._imu_bad_run += 1
+            self._last["imu_reason"] = reason
+
+    def _clear_imu(self) -> None:
+        self._pending_imu.clear()
+        self._last_imu_stamp = None
+        if self._predictor is not None:
+            self._predictor = GyroPredictor(self._camera, self._cfg.gyro)
+
+    def note_dropped(self, stamp_ns: int, reason: str = "a newer frame arrived before this one was processed") -> None:
+        """Count a frame the caller skipped (e.g. stale: processing fell behind)."""
+        with self._lock:
+            self.counters["frames_received"] += 1
+            self.counters["frames_dropped"] += 1
+            self._last["drop_reason"] = reason
+            self._recent.append((int(stamp_ns), "dropped"))
+
+    def note_bad_image(self, reason: str, stamp_ns: int | None = None) -> None:
+        """Count an image message that could not be converted (wrong encoding, step or size)."""
+        with self._lock:
+            self.counters["frames_received"] += 1
+            self.counters["images_malformed"] += 1
+            self._last["image_error"] = reason
+            self._image_bad = True
+            if stamp_ns is not None:
+                self._recent.append((int(stamp_ns), "malformed"))
+
+    # ------------------------------------------------------------------ tracking
+    def gyro_ready(self, stamp_ns: int) -> bool:
+        """True when processing the frame now loses nothing: the gyro covers it, or no prior can be
+        used anyway (gyro off, no camera, no target).  False: waiting for IMU samples may help."""
+        with self._lock:
+            if not self._cfg.use_gyro or self._predictor is None or self._ref is None:
+                return True
+            return self._predictor.ready(int(stamp_ns))
+
+    def init(self, frame: np.ndarray, box, stamp_ns: int) -> None:
+        """(Re)start tracking the target ``box`` = (x, y, w, h) in ``frame`` stamped ``stamp_ns``.
+
+        Raises ValueError for a bad frame or box (the previous target, if any, is kept then).
+        """
+        with self._track_lock:
+            tracker = IemdTracker(self._cfg.tracker)
+            tracker.init(frame, box)
+            with self._lock:
+                self._tracker = tracker
+                self._ref = (int(stamp_ns), tuple(float(v) for v in box), frame)
+                self._state, self._lost_run = "tracking", 0
+                self.counters["inits"] += 1
+                self._last["frame_reason"] = ""
+                if self._last_stamp is None or int(stamp_ns) > self._last_stamp:
+                    self._last_stamp = int(stamp_ns)
+
+    def reset(self) -> None:
+        """Forget the target (state "uninitialized"); IMU and camera are kept."""
+        with self._track_lock, self._lock:
+            self._tracker, self._ref = None, None
+            self._state, self._lost_run = "uninitialized", 0
+            self._last_result = None
+            self.counters["resets"] += 1
+
+    def process(self, frame: np.ndarray, stamp_ns: int) -> FrameResult:
+        """Track into ``frame`` (stamped ``stamp_ns``, camera clock); see :class:`FrameResult`."""
+        t = int(stamp_ns)
+        with self._track_lock:
+            with self._lock:
+                self.counters["frames_received"] += 1
+                self._image_bad = False
+                rejected = self._check_stamp(t)
+                if rejected:
+                    self.counters["frames_rejected"] += 1
+                    self._recent.append((t, "rejected"))
+                    self._last["frame_reason"] = rejected
+                    return FrameResult(t, self._state, rejected=rejected)
+                self._last_stamp = t
+                if self._tracker is None:
+                    self.counters["frames_uninitialized"] += 1
+                    self._recent.append((t, "uninitialized"))
+                    return FrameResult(t, "uninitialized", reason="no target: waiting for an initial box")
+                prior, gyro_box, gyro_reason = self._gyro_prior(t)
+            start = time.perf_counter()
+            try:
+                result = self._tracker.update(frame, prior=prior)
+            except ValueError as exc:
+                if prior is None:
+                    raise
+                gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
+                prior, gyro_box = None, None
+                result = self._tracker.update(frame)
+            ms = (time.perf_counter() - start) * 1e3
+            with self._lock:
+                return self._record(frame, t, result, prior is not None, gyro_reason, gyro_box, ms)
+
+    def _check_stamp(self, t: int) -> str:
+        """"" if a frame stamped ``t`` can be processed, else why not (handles clock resets)."""
+        last = self._last_stamp
+        if last is None or t > last:
+            return ""
+        back = last - t
+        if back > self._cfg.clock_reset_ms * 1e6:
+            self.counters["clock_resets"] += 1
+            self._last["frame_reason"] = f"image clock jumped back by {_ms(back)}: treated as a clock reset"
+            if self._ref is not None:
+                self._ref = (t, self._ref[1], self._ref[2])     # no rotation can be integrated across it
+            pred = self._predictor
+            if pred is not None and pred.buffer.t_newest_ns is not None \
+                    and pred.buffer.t_newest_ns > pred.imu_time(t) + self._cfg.clock_reset_ms * 1e6:
+                self._clear_imu()          # the IMU is still on the old clock
+            return ""
+        if back == 0:
+            return f"image stamp {t} ns repeats the previous frame's"
+        return f"image stamp went back by {_ms(back)} (previous frame {last} ns)"
+
+    def _gyro_prior(self, t: int):
+        """(prior or None, predicted box or None, reason) for the frame at ``t``."""
+        if not self._cfg.use_gyro:
+            return None, None, "gyro disabled (use_gyro is false)"
+        if self._predictor is None:
+            return None, None, "no camera_info received: the gyro prior needs K"
+        t_ref, box, _ = self._ref
+        if t == t_ref:
+            return None, None, "frame has the window's own stamp"
+        pred = self._predictor.predict(t_ref, t, box=box)
+        if pred.prior is None:
+            return None, None, pred.reason
+        gyro_box = tuple(float(v) for v in pred.box) if pred.box is not None else None
+        return pred.prior, gyro_box, pred.reason
+
+    def _record(self, frame, t, result, gyro_used, gyro_reason, gyro_box, ms) -> FrameResult:
+        c = self.counters
+        c["frames_processed"] += 1
+        c["gyro_used" if gyro_used else "gyro_unused"] += 1
+        box = tuple(float(v) for v in result.box)
+        if result.lost:
+            c["frames_lost"] += 1
+            self._lost_run += 1
+            self._state = "lost"
+        else:
+            self._lost_run = 0
+            self._state = "tracking"
+            self._ref = (t, box, frame)
+        emd = float(result.emd)
+        score = math.exp(-emd / self._cfg.score_emd_scale) if not result.lost and math.isfinite(emd) else 0.0
+        self._last["gyro_reason"] = gyro_reason
+        self._last["frame_reason"] = result.reason
+        self._recent.append((t, self._state))
+        self._recent_proc.append((t, ms, gyro_used))
+        out = FrameResult(t, self._state, box, emd, score, int(result.iterations), bool(result.lost), result.reason,
+                          "", gyro_used, gyro_reason, gyro_box,
+                          None if result.predicted_box is None else tuple(float(v) for v in result.predicted_box),
+                          float(result.scale), int(result.starts), ms)
+        self._last_result = out
+        return out
+
+    # ------------------------------------------------------------------ diagnostics
+    def last_reasons(self) -> dict:
+        """Latest explanations: frame_reason, gyro_reason, imu_reason, image_error, camera_error, drop_reason."""
+        with self._lock:
+            return dict(self._last)
+
+    def diagnostics(self) -> dict:
+        """Snapshot: counters, state, latest reasons and recent rates (stamps-based) and timings."""
+        with self._lock:
+            d = dict(self.counters)
+            d.update(self._last)
+            d["state"] = self._state
+            d["lost_run"] = self._lost_run
+            d["camera"] = "none" if self._camera is None else repr(self._camera)
+            proc = list(self._recent_proc)
+            d["processing_rate_hz"] = _rate([s for s, _, _ in proc])
+            d["input_rate_hz"] = _rate([s for s, _ in self._recent])
+            d["processing_ms_mean"] = float(np.mean([m for _, m, _ in proc])) if proc else math.nan
+            d["processing_ms_max"] = float(np.max([m for _, m, _ in proc])) if proc else math.nan
+            d["recent_dropped"] = sum(o == "dropped" for _, o in self._recent)
+            d["recent_frames"] = len(self._recent)
+            d["recent_gyro_used"] = sum(g for _, _, g in proc)
+            d["recent_processed"] = len(proc)
+            r = self._last_result
+            d["emd"] = math.nan if r is None else r.emd
+            d["iterations"] = 0 if r is None else r.iterations
+            d["imu_stored"] = 0 if self._predictor is None else len(self._predictor.buffer)
+            d["imu_pending"] = len(self._pending_imu)
+            if self._predictor is not None:
+                d["bias_status"] = self._predictor.bias_estimator.status
+            d["imu_bad_run"] = self._imu_bad_run
+            d["image_bad"] = self._image_bad
+            return d
+
+    def statuses(self, prefix: str = "iemd_tracker") -> list[Status]:
+        """OK/WARN/ERROR summaries: tracking, image input, IMU/gyro, camera_info."""
+        d = self.diagnostics()
+        cfg = self._cfg
+        fmt = {k: (f"{v:.3f}" if isinstance(v, float) else str(v)) for k, v in d.items()}
+
+        def vals(*keys):
+            return {k: fmt[k] for k in keys}
+
+        # tracking
+        if d["state"] == "uninitialized":
+            trk = (WARN, "no target: set the initial_box parameter or publish on ~/init")
+        elif d["state"] == "lost":
+            lvl = ERROR if d["lost_run"] >= _LOST_ERROR_FRAMES else WARN
+            trk = (lvl, f"target lost for {d['lost_run']} frame(s): {d['frame_reason']}")
+        else:
+            trk = (OK, f"tracking (EMD {d['emd']:.4f}, {d['iterations']} iterations)")
+        tracking = Status(f"{prefix}: tracking", *trk,
+                          vals("state", "emd", "iterations", "lost_run", "frames_lost", "processing_ms_mean",
+                               "processing_ms_max", "processing_rate_hz", "inits", "resets", "frame_reason"))
+        # image input
+        if d["image_bad"]:
+            img = (ERROR, f"latest image rejected: {d['image_error']}")
+        elif d["frames_received"] == 0:
+            img = (WARN, "no image received yet")
+        elif d["recent_frames"] and d["recent_dropped"] > d["recent_frames"] // 2:
+            img = (WARN, f"processing falls behind: {d['recent_dropped']} of the last {d['recent_frames']} "
+                         "frames dropped (the newest is kept)")
+        elif d["frames_rejected"] and d["frame_reason"].startswith("image stamp"):
+            img = (WARN, f"latest rejected frame: {d['frame_reason']}")
+        else:
+            img = (OK, f"{d['input_rate_hz']:.1f} Hz in, {d['processing_rate_hz']:.1f} Hz processed")
+        image = Status(f"{prefix}: image input", *img,
+                       vals("frames_received", "frames_processed", "frames_dropped", "frames_rejected",
+                            "images_malformed", "input_rate_hz", "processing_rate_hz", "recent_dropped",
+                            "image_error", "drop_reason", "clock_resets"))
+        # IMU / gyro
+        if not cfg.use_gyro:
+            imu = (OK, "gyro prior disabled (use_gyro is false)")
+        elif d["imu_bad_run"] >= _IMU_ERROR_RUN:
+            imu = (ERROR, f"the last {d['imu_bad_run']} IMU samples were rejected: {d['imu_reason']}")
+        elif d["imu_received"] == 0:
+            imu = (WARN, "no IMU message received: tracking without the gyro prior")
+        elif d["imu_bad_run"]:
+            imu = (WARN, d["imu_reason"])
+        elif d["recent_processed"] and self._last_result is not None and not self._last_result.gyro_used:
+            imu = (WARN, f"latest frame tracked without the gyro prior: {d['gyro_reason']}")
+        else:
+            imu = (OK, f"gyro prior used on {d['recent_gyro_used']} of the last {d['recent_processed']} frames")
+        keys = ["imu_received", "imu_rejected", "imu_out_of_order", "imu_saturated", "imu_stored", "imu_pending",
+                "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason"]
+        imu_status = Status(f"{prefix}: imu", *imu, vals(*keys, *(["bias_status"] if "bias_status" in d else [])))
+        # camera_info
+        if self._camera is None:
+            if d["camera_error"]:
+                cam = (ERROR, f"camera_info rejected: {d['camera_error']}")
+            elif cfg.use_gyro:
+                cam = (WARN, "no camera_info received: the gyro prior needs K")
+            else:
+                cam = (OK, "no camera_info (not needed: gyro disabled)")
+        elif d["camera_error"]:
+            cam = (WARN, f"latest camera_info rejected ({d['camera_error']}); keeping the previous one")
+        else:
+            cam = (OK, "camera model received")
+        camera = Status(f"{prefix}: camera_info", *cam, vals("camera", "camera_infos", "camera_infos_rejected",
+                                                              "camera_error"))
+        return [tracking, image, imu_status, camera]
+
+
+def _rate(stamps) -> float:
+    """Frames per second of message stamps (ns) over their span; nan with fewer than two."""
+    if len(stamps) < 2:
+        return math.nan
+    span = (max(stamps) - min(stamps)) * 1e-9
+    return (len(stamps) - 1) / span if span > 0 else math.nan
+
+
+def _same_gyro(a: GyroConfig, b: GyroConfig) -> bool:
+    return gyro_config_to_dict(a) == gyro_config_to_dict(b)

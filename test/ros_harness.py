@@ -1,0 +1,212 @@
+"""Shared helpers of the launch-free ROS tests: isolated DDS domain, a driver node that publishes a
+synthetic sequence (image + IMU + CameraInfo) and records detections and diagnostics."""
+from __future__ import annotations
+
+import os
+import random
+import threading
+import time
+from contextlib import contextmanager
+
+import rclpy
+import rclpy.executors
+from diagnostic_msgs.msg import DiagnosticArray
+from rcl_interfaces.srv import SetParameters
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, QoSReliabilityPolicy
+from sensor_msgs.msg import CameraInfo, Image, Imu
+from std_srvs.srv import Trigger
+from vision_msgs.msg import Detection2D, Detection2DArray
+
+from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp, stamp_to_ns
+
+FRAME_ID = "synthetic_cam"
+
+
+@contextmanager
+def isolated_ros_env():
+    """A random ROS_DOMAIN_ID in 30..99 and localhost-only discovery (restored afterwards)."""
+    saved = {k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")}
+    domain = random.SystemRandom().randint(30, 99)
+    os.environ["ROS_DOMAIN_ID"] = str(domain)
+    os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+    try:
+        yield domain
+    finally:
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
+
+
+def level(status) -> int:
+    lv = status.level
+    return lv[0] if isinstance(lv, (bytes, bytearray)) else int(lv)
+
+
+def stamp_ns(header) -> int:
+    return stamp_to_ns(header.stamp.sec, header.stamp.nanosec)
+
+
+class Driver:
+    """Test node: publishes image/imu/camera_info, ~/init; calls ~/reset and set_parameters;
+    records detections and diagnostics of the tracker node ``tracker``."""
+
+    def __init__(self, context, tracker: str = "iemd_tracker", image_topic: str = "image", reliable: bool = True):
+        self.node = rclpy.create_node("iemd_test_driver", context=context)
+        rel = QoSReliabilityPolicy.RELIABLE if reliable else QoSReliabilityPolicy.BEST_EFFORT
+        n = self.node
+        self.image_pub = n.create_publisher(Image, image_topic, QoSProfile(depth=10, reliability=rel))
+        self.imu_pub = n.create_publisher(Imu, "imu", QoSProfile(depth=200, reliability=rel))
+        self.info_pub = n.create_publisher(CameraInfo, "camera_info", QoSProfile(depth=10, reliability=rel))
+        self.init_pub = n.create_publisher(Detection2D, f"/{tracker}/init", 10)
+        self.reset_cli = n.create_client(Trigger, f"/{tracker}/reset")
+        self.param_cli = n.create_client(SetParameters, f"/{tracker}/set_parameters")
+        self.tracker = tracker
+        self.cond = threading.Condition()
+        self.detections: list[Detection2DArray] = []
+        self.diagnostics: list[DiagnosticArray] = []
+        n.create_subscription(Detection2DArray, "detections", self._on_det, 100)
+        n.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 100)
+
+    def _on_det(self, msg):
+        with self.cond:
+            self.detections.append(msg)
+            self.cond.notify_all()
+
+    def _on_diag(self, msg):
+        with self.cond:
+            self.diagnostics.append(msg)
+            self.cond.notify_all()
+
+    def wait_for(self, predicate, timeout: float) -> bool:
+        deadline = time.monotonic() + timeout
+        with self.cond:
+            while not predicate():
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return False
+                self.cond.wait(min(remaining, 0.05))
+            return True
+
+    def wait_connected(self, timeout: float = 10.0) -> bool:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if (self.image_pub.get_subscription_count() and self.imu_pub.get_subscription_count()
+                    and self.info_pub.get_subscription_count() and self.init_pub.get_subscription_count()
+                    and self.node.count_publishers("detections") and self.reset_cli.service_is_ready()
+                    and self.param_cli.service_is_ready()):
+                return True
+            time.sleep(0.05)
+        return False
+
+    # ---------------------------------------------------------------- publishing
+    def publish_image(self, frame, t_ns: int, **override) -> None:
+        msg = Image()
+        msg.header.frame_id = FRAME_ID
+        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+        f = {**array_to_image_fields(frame), **override}
+        msg.encoding, msg.height, msg.width, msg.step, msg.is_bigendian = (f["encoding"], f["height"], f["width"],
+                                                                           f["step"], f["is_bigendian"])
+        msg.data = f["data"]
+        self.image_pub.publish(msg)
+
+    def publish_imu(self, t_ns: int, w) -> None:
+        msg = Imu()
+        msg.header.frame_id = "imu"
+        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+        msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in w)
+        self.imu_pub.publish(msg)
+
+    def publish_camera_info(self, seq, k=None) -> None:
+        msg = CameraInfo()
+        msg.header.frame_id = FRAME_ID
+        msg.width, msg.height = seq.config.width, seq.config.height
+        msg.k = [float(v) for v in (seq.K.ravel() if k is None else k)]
+        msg.d = [float(v) for v in seq.dist]
+        msg.distortion_model = "plumb_bob"
+        self.info_pub.publish(msg)
+
+    def publish_init(self, box, t_ns: int) -> None:
+        msg = Detection2D()
+        msg.header.frame_id = FRAME_ID
+        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+        c = msg.bbox.center.position
+        c.x, c.y, msg.bbox.size_x, msg.bbox.size_y = box_to_bbox(box)
+        self.init_pub.publish(msg)
+
+    # ---------------------------------------------------------------- services
+    def _call(self, client, request, timeout: float = 10.0):
+        future = client.call_async(request)
+        deadline = time.monotonic() + timeout
+        while not future.done() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert future.done(), f"service {client.srv_name} did not answer within {timeout} s"
+        return future.result()
+
+    def reset(self):
+        return self._call(self.reset_cli, Trigger.Request())
+
+    def set_parameters(self, **values):
+        req = SetParameters.Request()
+        req.parameters = [Parameter(k, value=v).to_parameter_msg() for k, v in values.items()]
+        return self._call(self.param_cli, req).results
+
+    # ---------------------------------------------------------------- queries
+    def statuses(self, since: int = 0) -> list[dict]:
+        """Latest statuses of the tracker by kind ("tracking", "image input", "imu", "camera_info")."""
+        with self.cond:
+            arrays = list(self.diagnostics[since:])
+        out = []
+        for arr in arrays:
+            d = {}
+            for st in arr.status:
+                if st.name.startswith(f"{self.tracker}: "):
+                    d[st.name.split(": ", 1)[1]] = st
+            if d:
+                out.append(d)
+        return out
+
+    def wait_status(self, kind: str, predicate, timeout: float = 5.0):
+        """First diagnostics status of ``kind`` (received from now on) satisfying ``predicate``, or None."""
+        with self.cond:
+            start = len(self.diagnostics)
+        found = []
+
+        def check():
+            for d in self.statuses(start):
+                if kind in d and predicate(d[kind]):
+                    found.append(d[kind])
+                    return True
+            return False
+        # statuses() takes the lock itself; poll outside it
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if check():
+                return found[0]
+            time.sleep(0.05)
+        return None
+
+    def detections_since(self, start: int) -> list[Detection2DArray]:
+        with self.cond:
+            return list(self.detections[start:])
+
+
+def values(status) -> dict:
+    return {kv.key: kv.value for kv in status.values}
+
+
+@contextmanager
+def spinning(context, *nodes):
+    """Spin ``nodes`` in a background executor thread."""
+    ex = rclpy.executors.SingleThreadedExecutor(context=context)
+    for n in nodes:
+        ex.add_node(n)
+    th = threading.Thread(target=ex.spin, daemon=True)
+    th.start()
+    try:
+        yield ex
+    finally:
+        ex.shutdown(timeout_sec=2.0)
+        th.join(timeout=5.0)

@@ -1,0 +1,107 @@
+"""Message-field <-> numpy conversions (no ROS needed)."""
+import array
+
+import numpy as np
+import pytest
+
+from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info,
+                                  image_to_array, ns_to_stamp, stamp_to_ns)
+
+
+@pytest.fixture
+def bgr():
+    rng = np.random.default_rng(1)
+    return rng.integers(0, 256, (5, 7, 3), dtype=np.uint8)
+
+
+def _fields(pix, pad=0):
+    h = pix.shape[0]
+    rows = pix.reshape(h, -1).view(np.uint8).reshape(h, -1)
+    padded = np.concatenate([rows, np.full((h, pad), 0xEE, np.uint8)], axis=1)
+    return padded.shape[1], padded.tobytes()
+
+
+@pytest.mark.parametrize("pad", [0, 3])
+@pytest.mark.parametrize("container", [bytes, lambda b: array.array("B", b), lambda b: np.frombuffer(b, np.uint8)])
+def test_colour_encodings_give_bgr(bgr, pad, container):
+    alpha = np.full(bgr.shape[:2] + (1,), 200, np.uint8)
+    sources = {"bgr8": bgr, "rgb8": bgr[..., ::-1], "bgra8": np.concatenate([bgr, alpha], 2),
+               "rgba8": np.concatenate([bgr[..., ::-1], alpha], 2)}
+    for enc, pix in sources.items():
+        step, data = _fields(np.ascontiguousarray(pix), pad)
+        out = image_to_array(enc, 5, 7, step, container(data), False)
+        assert out.shape == (5, 7, 3) and out.dtype == np.uint8
+        np.testing.assert_array_equal(out, bgr, err_msg=enc)
+
+
+def test_mono_encodings():
+    grey = np.arange(35, dtype=np.uint8).reshape(5, 7) * 7
+    step, data = _fields(grey, 1)
+    np.testing.assert_array_equal(image_to_array("mono8", 5, 7, step, data), grey)
+    twelve = grey.astype(np.uint16) * 16 + 3          # a 12-bit sensor: max 3811 < 4096
+    for big in (False, True):
+        raw = twelve.astype(">u2" if big else "<u2")
+        step, data = _fields(raw)
+        out = image_to_array("mono16", 5, 7, step, data, big)
+        # highest used bit moved to bit 7: >> 4 here, not a fixed >> 8
+        np.testing.assert_array_equal(out, (twelve >> 4).astype(np.uint8))
+    full = np.full((2, 2), 65535, np.uint16)
+    assert image_to_array("mono16", 2, 2, 4, full.tobytes()).max() == 255
+
+
+def test_bad_images_raise_clear_errors(bgr):
+    step, data = _fields(bgr)
+    with pytest.raises(ValueError, match="unsupported image encoding 'yuv422'"):
+        image_to_array("yuv422", 5, 7, step, data)
+    with pytest.raises(ValueError, match="step 20 is shorter than one bgr8 row of 7 px \\(21 bytes\\)"):
+        image_to_array("bgr8", 5, 7, 20, data)
+    with pytest.raises(ValueError, match="has 105 bytes, expected step\\*height = 24\\*5 = 120"):
+        image_to_array("bgr8", 5, 7, 24, data)
+    with pytest.raises(ValueError, match="empty"):
+        image_to_array("mono8", 0, 7, 7, b"")
+    with pytest.raises(ValueError, match="bytes-like"):
+        image_to_array("mono8", 1, 2, 2, object())
+
+
+def test_array_to_image_fields_round_trip(bgr):
+    for enc in ("bgr8", "rgb8"):
+        f = array_to_image_fields(bgr, enc)
+        assert isinstance(f["data"], bytes) and f["step"] == 21
+        np.testing.assert_array_equal(image_to_array(**f), bgr)
+    g = array_to_image_fields(bgr[..., 0])
+    assert g["encoding"] == "mono8"
+    np.testing.assert_array_equal(image_to_array(**g), bgr[..., 0])
+    with pytest.raises(ValueError, match="cannot write"):
+        array_to_image_fields(bgr, "mono8")
+    with pytest.raises(ValueError, match="uint8"):
+        array_to_image_fields(bgr.astype(np.float32))
+
+
+def test_camera_model_from_info():
+    k = [500.0, 0, 319.5, 0, 510.0, 239.5, 0, 0, 1]
+    cam = camera_model_from_info(k, [0.1, -0.05, 0.001, 0.002, 0.0], "plumb_bob", 640, 480)
+    np.testing.assert_array_equal(cam.K, np.reshape(k, (3, 3)))
+    assert cam.has_distortion and (cam.width, cam.height) == (640, 480)
+    assert not camera_model_from_info(k, [], "", 0, 0).has_distortion
+    with pytest.raises(ValueError, match="not calibrated"):
+        camera_model_from_info([0.0] * 9, [], "plumb_bob", 640, 480)
+    with pytest.raises(ValueError, match="only plumb_bob"):
+        camera_model_from_info(k, [0.1, 0.0, 0.0, 0.0], "equidistant", 640, 480)
+    with pytest.raises(ValueError, match="9 values"):
+        camera_model_from_info(k[:6], [], "plumb_bob", 640, 480)
+
+
+def test_stamps():
+    assert stamp_to_ns(12, 345) == 12_000_000_345
+    assert ns_to_stamp(12_000_000_345) == (12, 345)
+    assert ns_to_stamp(stamp_to_ns(7, 999_999_999)) == (7, 999_999_999)
+
+
+def test_box_bbox_round_trip():
+    # a 4 px wide box starting at pixel 10 covers pixels 10..13: centre 11.5
+    assert box_to_bbox((10, 20, 4, 6)) == (11.5, 22.5, 4.0, 6.0)
+    assert bbox_to_box(11.5, 22.5, 4.0, 6.0) == (10.0, 20.0, 4.0, 6.0)
+    with pytest.raises(ValueError, match="positive size"):
+        bbox_to_box(1, 1, 0, 5)
+    with pytest.raises(ValueError, match="finite"):
+        bbox_to_box(float("nan"), 1, 3, 5)

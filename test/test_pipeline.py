@@ -1,0 +1,219 @@
+"""TrackingPipeline: message-level tracking with the gyro prior, input validation, diagnostics."""
+import math
+
+import numpy as np
+import pytest
+
+from iemd_ros.gyro import GyroConfig, GyroPredictor, box_centre
+from iemd_ros.pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
+from iemd_ros.synthetic import generate
+from iemd_ros.tracker import TrackerConfig
+
+N = 24
+
+
+@pytest.fixture(scope="module")
+def seq():
+    # strong shake: without the gyro prior the target leaves the search range
+    return generate(n_frames=N, max_rate_deg_s=150.0, time_offset_s=0.004, seed=3)
+
+
+def _pipeline(seq, **over):
+    cfg = PipelineConfig.from_dict({"gyro": {"time_offset_ns": seq.time_offset_ns}, **over})
+    return TrackingPipeline(cfg)
+
+
+def _feed_imu(p, seq, upto_ns=None):
+    for t, w in zip(seq.gyro_t_ns, seq.gyro, strict=True):
+        if upto_ns is None or t <= upto_ns:
+            p.add_imu(int(t), w)
+
+
+def _run(p, seq, frames=None):
+    frames = seq.frames if frames is None else frames
+    p.init(frames[0], seq.gt_boxes[0], int(seq.frame_stamps_ns[0]))
+    return [p.process(frames[k], int(seq.frame_stamps_ns[k])) for k in range(1, len(frames))]
+
+
+def _centre_errors(results, seq):
+    return np.array([np.hypot(*(box_centre(r.box) - seq.gt_centres[k + 1])) for k, r in enumerate(results)])
+
+
+def test_tracks_synthetic_shake_with_gyro_and_is_deterministic(seq):
+    runs = []
+    for _ in range(2):
+        p = _pipeline(seq)
+        _feed_imu(p, seq)                 # IMU before camera_info: kept and used once K arrives
+        p.set_camera(seq.camera)
+        runs.append(_run(p, seq))
+    res = runs[0]
+    err = _centre_errors(res, seq)
+    assert all(r.state == "tracking" and r.gyro_used for r in res), [(r.state, r.gyro_reason) for r in res]
+    assert err.max() < 6.0, err            # measured: max 0.3-0.8 px (320x240, 150 deg/s); 109 px without gyro
+    assert all(0.0 < r.score <= 1.0 and r.score == pytest.approx(math.exp(-r.emd / 0.25)) for r in res)
+    # the same messages give the same results (only the wall-clock timing differs)
+    strip = [{**r.as_dict(), "processing_ms": 0} for r in runs[0]]
+    assert strip == [{**r.as_dict(), "processing_ms": 0} for r in runs[1]]
+    d = p.diagnostics()
+    assert d["frames_processed"] == N - 1 and d["gyro_used"] == N - 1 and d["imu_pending"] == 0
+    assert d["processing_rate_hz"] == pytest.approx(seq.config.fps)
+    assert [s.level for s in p.statuses()] == [OK, OK, OK, OK]
+
+
+def test_without_gyro_the_shake_is_not_followed_and_the_reason_is_given(seq):
+    p = _pipeline(seq, use_gyro=False)
+    _feed_imu(p, seq)
+    p.set_camera(seq.camera)
+    res = _run(p, seq)
+    assert not any(r.gyro_used for r in res)
+    assert res[0].gyro_reason == "gyro disabled (use_gyro is false)"
+    assert _centre_errors(res, seq).max() > 20.0   # the peer of the test above: the prior matters here
+
+
+def test_no_camera_info_tracks_without_prior_and_warns(seq):
+    p = _pipeline(seq)
+    _feed_imu(p, seq)
+    p.init(seq.frames[0], seq.gt_boxes[0], int(seq.frame_stamps_ns[0]))
+    r = p.process(seq.frames[1], int(seq.frame_stamps_ns[1]))
+    assert not r.gyro_used and "camera_info" in r.gyro_reason
+    status = {s.name.split(": ")[1]: s for s in p.statuses()}
+    assert status["camera_info"].level == WARN and "needs K" in status["camera_info"].message
+    assert status["imu"].level == WARN and "without the gyro prior" in status["imu"].message
+
+
+def test_gyro_integrates_from_the_last_frame_that_was_not_lost(seq):
+    p = _pipeline(seq)
+    p.set_camera(seq.camera)
+    _feed_imu(p, seq)
+    stamps = [int(s) for s in seq.frame_stamps_ns]
+    p.init(seq.frames[0], seq.gt_boxes[0], stamps[0])
+    res = {k: p.process(seq.frames[k], stamps[k]) for k in range(1, 6)}
+    noise = np.random.default_rng(0).integers(0, 256, seq.frames[6].shape, dtype=np.uint8)
+    res[6] = p.process(noise, stamps[6])
+    assert res[6].state == "lost" and "EMD" in res[6].reason
+    assert p.statuses()[0].level == WARN
+    res[7] = p.process(seq.frames[7], stamps[7])
+    ref = GyroPredictor(seq.camera, GyroConfig(time_offset_ns=seq.time_offset_ns))
+    ref.add_imu(seq.gyro_t_ns, seq.gyro)
+    right = ref.predict(stamps[5], stamps[7], box=res[5].box).box
+    wrong = ref.predict(stamps[6], stamps[7], box=res[5].box).box
+    np.testing.assert_allclose(res[7].gyro_box, right, atol=1e-9)
+    assert np.hypot(*(box_centre(right) - box_centre(wrong))) > 2.0
+    assert res[7].state == "tracking"
+
+
+def test_imu_validation_counts_and_explains(seq):
+    p = _pipeline(seq, gyro={"time_offset_ns": seq.time_offset_ns, "saturation": 5.0})
+    p.set_camera(seq.camera)
+    t0 = int(seq.gyro_t_ns[0])
+    assert p.add_imu(t0, (0.0, 0.1, 0.0))
+    assert not p.add_imu(t0 + 5_000_000, (np.nan, 0.0, 0.0))
+    assert "not 3 finite" in p.last_reasons()["imu_reason"]
+    assert not p.add_imu(t0 + 6_000_000, (0.0, np.inf, 0.0))
+    assert not p.add_imu(t0 + 7_000_000, (6.0, 0.0, 0.0))
+    assert "saturation" in p.last_reasons()["imu_reason"]
+    assert p.add_imu(t0 + 10_000_000, (0.0, 0.1, 0.0))
+    assert p.add_imu(t0 + 8_000_000, (0.0, 0.1, 0.0))     # 2 ms back: counted, put in order
+    assert "went back by 2.0 ms" in p.last_reasons()["imu_reason"]
+    d = p.diagnostics()
+    assert (d["imu_rejected"], d["imu_saturated"], d["imu_out_of_order"], d["imu_stored"]) == (2, 1, 1, 3)
+    for i in range(10):                                    # a dead stream is an ERROR
+        p.add_imu(t0 + 20_000_000 + i, (np.nan,) * 3)
+    assert p.statuses()[2].level == ERROR
+    p.add_imu(t0 + 40_000_000, (0.0, 0.0, 0.0))
+    assert p.statuses()[2].level != ERROR
+    p.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
+    assert p.diagnostics()["imu_rejected"] == 13 and "covariance" in p.statuses()[2].message
+    # a clock reset (bag loop): the IMU buffer restarts
+    assert p.add_imu(t0 - 5_000_000_000, (0.0, 0.0, 0.0))
+    d = p.diagnostics()
+    assert d["clock_resets"] == 1 and d["imu_stored"] == 1 and "jumped back" in d["imu_reason"]
+
+
+def test_frame_stamps_going_back_are_rejected_or_reset(seq):
+    p = _pipeline(seq)
+    p.set_camera(seq.camera)
+    _feed_imu(p, seq)
+    s = [int(v) for v in seq.frame_stamps_ns]
+    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    assert p.process(seq.frames[2], s[2]).tracking
+    r = p.process(seq.frames[1], s[1])
+    assert r.rejected.startswith("image stamp went back by 33.3 ms") and r.box is None
+    assert "repeats" in p.process(seq.frames[2], s[2]).rejected
+    assert p.diagnostics()["frames_rejected"] == 2
+    assert p.statuses()[1].level == WARN
+    # far back: clock reset, processed without a prior (nothing to integrate across the reset)
+    r = p.process(seq.frames[3], s[3] - 10_000_000_000)
+    assert not r.rejected and not r.gyro_used and p.diagnostics()["clock_resets"] == 1
+
+
+def test_gyro_ready_and_uninitialized_state(seq):
+    p = _pipeline(seq)
+    p.set_camera(seq.camera)
+    s = [int(v) for v in seq.frame_stamps_ns]
+    r = p.process(seq.frames[0], s[0])
+    assert r.state == "uninitialized" and r.box is None and r.score == 0.0
+    assert p.statuses()[0].level == WARN and "initial_box" in p.statuses()[0].message
+    assert p.gyro_ready(s[1])                      # no target: nothing to wait for
+    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    _feed_imu(p, seq, upto_ns=s[1] + seq.time_offset_ns - 1)
+    assert not p.gyro_ready(s[1])                  # gyro stops just before the frame
+    r = p.process(seq.frames[1], s[1])
+    assert not r.gyro_used and "not covering" in r.gyro_reason
+    _feed_imu(p, seq)
+    assert p.gyro_ready(s[2])
+    p.reset()
+    assert p.state == "uninitialized" and p.diagnostics()["resets"] == 1
+
+
+def test_configure_validates_and_restarts_the_tracker(seq):
+    with pytest.raises(ValueError, match="alpha"):
+        PipelineConfig.from_dict({"tracker": {"alpha": 1.5}})
+    with pytest.raises(ValueError, match="rotation"):
+        PipelineConfig.from_dict({"gyro": {"R_cam_imu": [1, 0, 0, 0, 1, 0, 0, 0, -1]}})
+    with pytest.raises(ValueError, match="unknown"):
+        PipelineConfig.from_dict({"gyro": {"offset": 1}})
+    with pytest.raises(ValueError, match="imu_wait_ms"):
+        PipelineConfig(imu_wait_ms=-1)
+    cfg = PipelineConfig.from_dict({"gyro": {"time_offset_ns": 5, "R_cam_imu": np.eye(3).ravel().tolist()}})
+    assert PipelineConfig.from_dict(cfg.to_dict()).to_dict() == cfg.to_dict()
+    p = _pipeline(seq)
+    p.set_camera(seq.camera)
+    _feed_imu(p, seq)
+    s = [int(v) for v in seq.frame_stamps_ns]
+    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    r1 = p.process(seq.frames[1], s[1])
+    stored = p.diagnostics()["imu_stored"]
+    new = PipelineConfig(tracker=TrackerConfig(n_particles=0), gyro=p.config.gyro)
+    assert "restarted" in p.configure(new)
+    assert p.state == "tracking" and p.diagnostics()["imu_stored"] == stored
+    gyro2 = PipelineConfig(tracker=new.tracker, gyro=GyroConfig(time_offset_ns=seq.time_offset_ns, max_gap_ns=10**8))
+    assert "rebuilt" in p.configure(gyro2) and p.diagnostics()["imu_stored"] == stored
+    r2 = p.process(seq.frames[2], s[2])
+    assert r2.gyro_used and np.hypot(*(box_centre(r2.box) - seq.gt_centres[2])) < 6.0
+    assert r1.tracking
+
+
+def test_input_problem_statuses(seq):
+    p = _pipeline(seq)
+    p.note_bad_camera_info("camera_info k is all zero: the camera is not calibrated")
+    st = p.statuses()
+    assert st[3].level == ERROR and "not calibrated" in st[3].message
+    assert st[1].level == WARN and "no image" in st[1].message
+    p.note_bad_image("unsupported image encoding 'yuv422'", 1)
+    assert p.statuses()[1].level == ERROR and "yuv422" in p.statuses()[1].message
+    p.set_camera(seq.camera)
+    assert p.statuses()[3].level == OK
+    p.init(seq.frames[0], seq.gt_boxes[0], int(seq.frame_stamps_ns[0]))
+    for k in range(1, 5):
+        p.note_dropped(int(seq.frame_stamps_ns[k]))
+    p.process(seq.frames[5], int(seq.frame_stamps_ns[5]))
+    st = p.statuses()
+    assert st[1].level == WARN and "falls behind" in st[1].message
+    assert p.diagnostics()["frames_dropped"] == 4 and p.diagnostics()["images_malformed"] == 1
+    assert st[2].level == WARN and "no IMU" in st[2].message
+
+
+def test_frame_result_defaults():
+    r = FrameResult(5, "lost")
+    assert not r.tracking and math.isnan(r.emd) and r.as_dict()["stamp_ns"] == 5
