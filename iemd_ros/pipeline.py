@@ -145,7 +145,7 @@ class FrameResult:
     ("" when it was).  ``box``/``emd``/``iterations``/``reason`` come from the tracker (``box`` is the
     best window searched, also when lost); ``score`` = ``exp(-emd / score_emd_scale)`` while
     tracking, else 0.  ``gyro_box``: the gyro's predicted window; ``predicted_box``: the tracker's
-    starting window (gyro prior + constant velocity).  ``processing_ms`` is wall-clock time.
+    starting window (after the gyro prior).  ``processing_ms`` is wall-clock time.
     """
 
     stamp_ns: int
