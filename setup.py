@@ -76,6 +76,9 @@ setup(
             "iemd-demo = iemd_ros.demo:main",
             "iemd-eval = iemd_ros.evaluation:main",
             "iemd-tracker = iemd_ros.node:main",
+            "iemd-replay = iemd_ros.replay:main",
+            "iemd-make-bag = iemd_ros.bag_make:main",
+            "iemd-play = iemd_ros.bag_play:main",
         ],
     },
 )

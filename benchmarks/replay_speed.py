@@ -1,0 +1,102 @@
+#!/usr/bin/env python3
+"""Offline replay speed on the CMU desk sequence, against real time (the issue asks for >= 3x).
+
+Makes the desk bag with ``iemd-make-bag`` (mcap, bgr8, 640x480 at 30 fps, 100 Hz IMU) in a temporary
+folder, then measures in the same run:
+
+* the bag I/O alone (read + CDR decode + ``image_to_array`` of every message): the replay's floor;
+* the full offline replay (``iemd_ros.replay.replay``: synchronization, gyro prediction, tracker), with
+  the gyro prior and, with ``--no-gyro-too``, without it.
+
+Printed: bag duration, wall time, the real-time factor (bag time / wall time; > 1 is faster than real
+time), the share of the wall time spent in the tracker's ``update``, the tracker's mean ms/frame, and the
+time of everything else in the replay (its own overhead, which alone must allow >= 3x).
+
+    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py [--frames N] [--no-gyro-too] [--keep DIR]
+"""
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from iemd_ros.bag_io import deserialize, iter_messages, open_bag, select_topics
+from iemd_ros.bag_make import source_from_folder, write_bag
+from iemd_ros.conversions import image_to_array
+from iemd_ros.replay import replay
+
+DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
+
+
+def io_only(bag: Path) -> tuple[float, int]:
+    """Seconds to read and decode every message of the replayed topics, and the number of images."""
+    reader = open_bag(bag)
+    try:
+        topics = select_topics(reader)
+        conns = [c for c in reader.connections if c.topic in {topics.image, topics.imu, topics.camera_info}]
+        t0 = time.perf_counter()
+        n = 0
+        for conn, _, raw in iter_messages(reader, conns, bag):
+            msg = deserialize(reader, raw, conn.msgtype, bag)
+            if conn.topic == topics.image:
+                image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, bool(msg.is_bigendian))
+                n += 1
+        return time.perf_counter() - t0, n
+    finally:
+        reader.close()
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--desk", type=Path, default=DESK, help="cmu_hwangbo_desk folder")
+    ap.add_argument("--frames", type=int, default=None, help="first N frames only (default: all 825)")
+    ap.add_argument("--no-gyro-too", action="store_true", help="also replay without the gyro prior")
+    ap.add_argument("--keep", type=Path, default=None, help="write the bag here and keep it")
+    a = ap.parse_args()
+    if not a.desk.is_dir():
+        print(f"replay_speed: the desk recording is not at {a.desk}", file=sys.stderr)
+        return 2
+    tmp = Path(tempfile.mkdtemp(prefix="iemd_replay_speed_"))
+    bag = a.keep if a.keep is not None else tmp / "desk"
+    try:
+        src = source_from_folder(a.desk)
+        t0 = time.perf_counter()
+        info = write_bag(src, bag, "mcap", count=a.frames)
+        t_make = time.perf_counter() - t0
+        print(f"bag: {info['frames']} images {info['size'][0]}x{info['size'][1]} bgr8 + {info['imu']} IMU samples "
+              f"-> {bag} (made in {t_make:.1f} s)")
+        t_io, n = io_only(bag)
+        init = tuple(float(v) for v in src.gt_boxes[0])
+        runs = [("gyro", True)] + ([("no-gyro", False)] if a.no_gyro_too else [])
+        results = []
+        for label, use in runs:
+            res = replay(bag, init, use_gyro=use, progress=None)
+            results.append((label, res))
+        dur = results[0][1].duration_s
+        print(f"\nbag duration (images): {dur:.2f} s ({n} frames)\n")
+        print(f"{'run':<16} {'wall s':>8} {'x real time':>12} {'tracker %':>10} {'tracker ms/frame':>17}")
+        print(f"{'bag I/O only':<16} {t_io:8.2f} {dur / t_io:12.2f} {'-':>10} {'-':>17}")
+        for label, res in results:
+            per = 1e3 * res.track_s / max(len(res.results) - 1, 1)
+            print(f"{'replay ' + label:<16} {res.wall_s:8.2f} {res.realtime_factor:12.2f} "
+                  f"{100 * res.track_s / res.wall_s:10.1f} {per:17.1f}")
+        res = results[0][1]
+        rf = res.realtime_factor
+        rest = res.wall_s - res.track_s - res.init_s
+        print(f"\noffline replay with gyro: {rf:.2f}x real time "
+              f"({'meets' if rf >= 3 else 'does NOT meet'} the >= 3x target)")
+        print(f"tracker init (first frame, one-off): {res.init_s:.2f} s")
+        print(f"everything but the tracker (bag I/O, decoding, synchronization, gyro prediction, CSV): "
+              f"{rest:.2f} s = {1e3 * rest / n:.1f} ms/frame -> {dur / rest:.1f}x real time; for 3x the tracker "
+              f"update must stay below {max(1e3 * (dur / 3 - rest - res.init_s) / n, 0):.1f} ms/frame")
+        return 0
+    finally:
+        if a.keep is None:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,194 @@
+"""iemd-make-bag: stamps on the camera clock, IMU shifted by the recording's offset, message contents,
+formats (mcap, sqlite3, ROS 1), sources (synthetic, image folder + CSV, CMU desk, phone, OTB), bad input."""
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
+
+from iemd_ros.bag_io import custom_data, open_bag
+from iemd_ros.bag_make import DEFAULT_TOPICS, main, source_from_folder, write_bag
+from iemd_ros.otb import load_sequence
+from iemd_ros.recordings import load_gt_boxes, load_recording
+
+REPO = Path(__file__).resolve().parents[1]
+IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT_TOPICS["imu"]
+
+
+@pytest.fixture(scope="module")
+def seq():
+    return shaky_sequence(8)
+
+
+def _check_synthetic_bag(path, seq, encoding="bgr8"):
+    msgs = read_all(path)
+    imgs, infos, imus = by_topic(msgs, IMG), by_topic(msgs, INFO), by_topic(msgs, IMU)
+    assert len(imgs) == len(infos) == len(seq.frames)
+    np.testing.assert_array_equal(stamps(imgs), seq.frame_stamps_ns)      # camera clock
+    np.testing.assert_array_equal(stamps(infos), seq.frame_stamps_ns)
+    # IMU: shifted onto the camera clock by -t_d (t_imu = t_cam + t_d), only within 0.5 s of the frames
+    t_cam = seq.gyro_t_ns - seq.time_offset_ns
+    keep = (t_cam >= seq.frame_stamps_ns[0] - 500_000_000) & (t_cam <= seq.frame_stamps_ns[-1] + 500_000_000)
+    np.testing.assert_array_equal(stamps(imus), t_cam[keep])
+    w = np.array([[m.angular_velocity.x, m.angular_velocity.y, m.angular_velocity.z] for m in imus])
+    np.testing.assert_array_equal(w, seq.gyro[keep])
+    assert all(m.angular_velocity_covariance[0] == 0 and m.orientation_covariance[0] == -1 for m in imus)
+    assert all(m.linear_acceleration_covariance[0] == -1 for m in imus)      # no accelerometer
+    for k, m in enumerate(imgs):
+        assert m.encoding == encoding and (m.height, m.width) == seq.frames[k].shape[:2]
+        want = seq.frames[k] if encoding == "bgr8" else cv2.cvtColor(seq.frames[k], cv2.COLOR_BGR2GRAY)
+        np.testing.assert_array_equal(m.data.reshape(want.shape), want)
+        assert m.step == want.shape[1] * (3 if encoding == "bgr8" else 1)
+    k_field = infos[0].k if hasattr(infos[0], "k") else infos[0].K
+    np.testing.assert_allclose(np.asarray(k_field).reshape(3, 3), seq.K)
+    # log times strictly increase; images/infos are logged at their stamp (+ns tie-breaks)
+    log = np.array([t for _, _, t, _ in msgs])
+    assert np.all(np.diff(log) > 0)
+    img_log = np.array([t for topic, _, t, _ in msgs if topic == IMG])
+    assert np.all((img_log - seq.frame_stamps_ns >= 0) & (img_log - seq.frame_stamps_ns < 1000))
+    return msgs
+
+
+@pytest.mark.parametrize("fmt,name", [("mcap", "b_mcap"), ("sqlite3", "b_sqlite"), ("ros1", "b.bag")])
+def test_synthetic_bag_formats(seq, tmp_path, fmt, name):
+    info = make_bag(seq, tmp_path / name, fmt)
+    assert info["frames"] == 8 and info["imu_time_shift_ns"] == -seq.time_offset_ns
+    msgs = _check_synthetic_bag(tmp_path / name, seq)
+    if fmt == "ros1":        # ROS 1: Header.seq counts per topic, CameraInfo uses K/D
+        assert [m.header.seq for m in by_topic(msgs, IMG)] == list(range(8))
+    else:
+        reader = open_bag(tmp_path / name)
+        meta = custom_data(reader)
+        reader.close()
+        assert meta["iemd_ros.imu_time_shift_ns"] == str(-seq.time_offset_ns)
+        assert (tmp_path / name / "metadata.yaml").is_file()
+
+
+def test_mono8_and_excerpt(seq, tmp_path):
+    info = make_bag(seq, tmp_path / "m", encoding="mono8", first=2, count=4, imu_margin_s=0.0)
+    assert info["frames"] == 4
+    msgs = read_all(tmp_path / "m")
+    imgs, imus = by_topic(msgs, IMG), by_topic(msgs, IMU)
+    np.testing.assert_array_equal(stamps(imgs), seq.frame_stamps_ns[2:6])
+    np.testing.assert_array_equal(imgs[0].data.reshape(240, 320), cv2.cvtColor(seq.frames[2], cv2.COLOR_BGR2GRAY))
+    t = stamps(imus)        # margin 0: only samples between the first and the last frame
+    assert t.min() >= seq.frame_stamps_ns[2] and t.max() <= seq.frame_stamps_ns[5] and len(t) > 10
+
+
+def _write_folder(seq, folder: Path, offset_ms: float, step_back: bool = False):
+    """An image folder + stamps file + IMU CSV (IMU clock) + camera YAML, as a user brings them."""
+    (folder / "images").mkdir(parents=True)
+    for k, f in enumerate(seq.frames):
+        cv2.imwrite(str(folder / "images" / f"frame_{k:04d}.png"), f)
+    (folder / "stamps.txt").write_text("".join(f"{t / 1e9:.9f}\n" for t in seq.frame_stamps_ns))
+    t_imu = seq.gyro_t_ns.copy()
+    if step_back:                           # a clock stepping back by 3 ms at one row (as the CMU desk log)
+        t_imu[40] = t_imu[39] - 3_000_000
+    rows = ["# t_s, wx, wy, wz", "t,wx,wy,wz"] + [f"{t / 1e9:.9f}," + ",".join(repr(float(v)) for v in w)
+                                                  for t, w in zip(t_imu, seq.gyro)]
+    (folder / "imu.csv").write_text("\n".join(rows) + "\n")
+    import yaml
+
+    (folder / "camera.yaml").write_text(yaml.safe_dump(seq.camera.to_camera_info()))
+    return t_imu
+
+
+def test_image_folder_with_imu_csv(seq, tmp_path):
+    t_imu = _write_folder(seq, tmp_path / "rec", offset_ms=4.0, step_back=True)
+    rc = main([str(tmp_path / "rec" / "images"), str(tmp_path / "bag"), "--stamps", str(tmp_path / "rec" / "stamps.txt"),
+               "--imu-csv", str(tmp_path / "rec" / "imu.csv"), "--camera-yaml", str(tmp_path / "rec" / "camera.yaml"),
+               "--time-offset-ms", "4", "--imu-margin", "10"])
+    assert rc == 0
+    msgs = read_all(tmp_path / "bag")
+    imus = by_topic(msgs, IMU)
+    # every sample, in the recorded row order (the step back kept), shifted by -4 ms
+    np.testing.assert_array_equal(stamps(imus), t_imu - 4_000_000)
+    assert imus[0].header.frame_id == "imu_link" and by_topic(msgs, IMG)[0].header.frame_id == "camera_optical_frame"
+    np.testing.assert_array_equal(by_topic(msgs, IMG)[3].data.reshape(240, 320, 3), seq.frames[3])
+    # the stepped-back sample is logged when it arrived (after its predecessor), so log order = row order
+    imu_log = [t for topic, _, t, _ in msgs if topic == IMU]
+    assert np.all(np.diff(imu_log) > 0)
+
+
+def test_cmu_desk_excerpt(imu_root, tmp_path):
+    rec = load_recording(imu_root / "cmu_hwangbo_desk")
+    src = source_from_folder(imu_root / "cmu_hwangbo_desk")
+    info = write_bag(src, tmp_path / "desk", "mcap", first=10, count=5, gt_out=tmp_path / "gt.txt")
+    assert info["imu_time_shift_ns"] == 20_000_000                    # t_imu = t_file - 20 ms
+    msgs = read_all(tmp_path / "desk")
+    imgs, imus, infos = by_topic(msgs, IMG), by_topic(msgs, IMU), by_topic(msgs, INFO)
+    np.testing.assert_array_equal(stamps(imgs), rec.frame_stamps_ns[10:15])
+    np.testing.assert_array_equal(imgs[0].data.reshape(480, 640, 3), rec.load_frame(10))
+    t = stamps(imus)
+    sel = np.nonzero(np.isin(rec.imu_t_ns + 20_000_000, t))[0]
+    np.testing.assert_array_equal(t, rec.imu_t_ns[sel] + 20_000_000)
+    np.testing.assert_array_equal([m.angular_velocity.x for m in imus], rec.gyro[sel, 0])
+    np.testing.assert_array_equal([m.linear_acceleration.z for m in imus], rec.accel[sel, 2])
+    # camera-frame gyro: the IMU frame_id is the camera's (identity extrinsic)
+    assert imus[0].header.frame_id == imgs[0].header.frame_id == "camera_optical_frame"
+    np.testing.assert_allclose(np.asarray(infos[0].k).reshape(3, 3), rec.camera.K)
+    np.testing.assert_allclose(infos[0].d, rec.camera.D)
+    gt, flags = load_gt_boxes(tmp_path / "gt.txt")
+    np.testing.assert_allclose(gt, rec.gt_boxes[10:15], atol=1e-9)
+    assert list(flags) == list(rec.gt_flags[10:15])
+
+
+def test_phone_excerpt(imu_root, tmp_path):
+    rec = load_recording(imu_root / "phone_gyrostab_20200109_145447")
+    info = write_bag(source_from_folder(rec.root), tmp_path / "phone", "sqlite3", count=3)
+    assert info["imu_time_shift_ns"] == -rec.time_offset_ns == -13_000_000
+    msgs = read_all(tmp_path / "phone")
+    assert stamps(by_topic(msgs, IMG))[0] == rec.frame_stamps_ns[0]
+    assert by_topic(msgs, IMG)[0].width == 800 and len(by_topic(msgs, IMU)) > 400   # 412 Hz over ~1.07 s
+
+
+def test_otb_folder(otb_root, tmp_path):
+    seq = load_sequence(otb_root / "Deer")
+    assert main([str(otb_root / "Deer"), str(tmp_path / "deer"), "--count", "5", "--fps", "25",
+                 "--gt-out", str(tmp_path / "gt.txt")]) == 0
+    msgs = read_all(tmp_path / "deer")
+    assert {t for t, _, _, _ in msgs} == {IMG}                      # OTB: no IMU, no calibration
+    np.testing.assert_array_equal(np.diff(stamps(by_topic(msgs, IMG))), 40_000_000)
+    from iemd_ros.otb import parse_groundtruth
+
+    np.testing.assert_allclose(parse_groundtruth(tmp_path / "gt.txt"), seq.gt_boxes[:5], atol=1e-9)
+
+
+def test_bad_input(seq, tmp_path, capsys):
+    (tmp_path / "empty").mkdir()
+    make_bag(seq, tmp_path / "exists")
+    cases = [
+        ([str(tmp_path / "nope"), str(tmp_path / "o1")], "is not a folder"),
+        ([str(tmp_path / "empty"), str(tmp_path / "o2")], "holds no image"),
+        ([str(tmp_path / "empty"), str(tmp_path / "exists")], "holds no image"),
+        ([str(tmp_path / "empty"), str(tmp_path / "o3"), "--format", "zip"], "invalid choice"),
+    ]
+    for argv, text in cases:
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and text in err and err.startswith("iemd-make-bag: error:"), err
+    # output exists / count too large / ROS 1 path without .bag, through a real source
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in range(3):
+        cv2.imwrite(str(folder / f"{k}.png"), seq.frames[k])
+    for argv, text in [([str(folder), str(tmp_path / "exists")], "exists already"),
+                       ([str(folder), str(tmp_path / "o4"), "--count", "5"], "exceeds the 3 frames"),
+                       ([str(folder), str(tmp_path / "o5"), "--format", "ros1"], "must be a file ending in .bag"),
+                       ([str(folder), str(tmp_path / "o6"), "--imu-csv", str(tmp_path / "none.csv")], "cannot read IMU")]:
+        assert main(argv) == 2
+        err = capsys.readouterr().err.strip()
+        assert err.count("\n") == 0 and text in err, err
+    assert not (tmp_path / "o4").exists() and not (tmp_path / "o6").exists()   # no partial output
+
+
+def test_cli_process(tmp_path):
+    """The real process: exit status 2 and one line, no traceback."""
+    out = subprocess.run([sys.executable, "-m", "iemd_ros.bag_make", str(tmp_path / "missing"), str(tmp_path / "o")],
+                         capture_output=True, text=True, cwd=REPO, timeout=120,
+                         env={**__import__("os").environ, "PYTHONPATH": str(REPO)})
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert out.stderr.strip().count("\n") == 0 and "is not a folder" in out.stderr

@@ -1,0 +1,286 @@
+"""iemd-replay: deterministic CSV, outputs (bag with detections + diagnostics, MP4, metrics), topic
+selection, ROS 1 vs converted ROS 2 vs direct ROS 2 bags, bad input (exit 2, one line), no IMU."""
+import csv
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
+
+from iemd_ros.bag_io import BagWriter, header
+from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag, write_gt
+from iemd_ros.conversions import bbox_to_box
+from iemd_ros.metrics import iou, score_sequence
+from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, replay
+
+REPO = Path(__file__).resolve().parents[1]
+N = 10
+
+
+@pytest.fixture(scope="module")
+def seq():
+    return shaky_sequence(N)
+
+
+@pytest.fixture(scope="module")
+def bags(seq, tmp_path_factory):
+    d = tmp_path_factory.mktemp("bags")
+    make_bag(seq, d / "shaky")
+    write_gt(d / "gt.txt", seq.gt_boxes)
+    return d
+
+
+def _init(seq) -> str:
+    return ",".join(repr(float(v)) for v in seq.gt_boxes[0])
+
+
+def _rows(path):
+    with open(path, newline="") as f:
+        return list(csv.reader(f))
+
+
+def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
+    argv = [str(bags / "shaky"), "--init", _init(seq)]
+    assert main(argv + ["--csv", str(tmp_path / "a.csv"), "--out-bag", str(tmp_path / "out"),
+                        "--video", str(tmp_path / "v.mp4"), "--gt", str(bags / "gt.txt")]) == 0
+    printed = capsys.readouterr().out
+    assert main(argv + ["--csv", str(tmp_path / "b.csv")]) == 0
+    a, b = (tmp_path / "a.csv").read_bytes(), (tmp_path / "b.csv").read_bytes()
+    assert a == b                                              # same bag twice -> identical CSV
+    rows = _rows(tmp_path / "a.csv")
+    assert tuple(rows[0]) == CSV_HEADER and len(rows) == N + 1   # one row per image
+    assert [int(r[0]) for r in rows[1:]] == seq.frame_stamps_ns.tolist()
+    assert rows[1][6] == "init" and rows[1][5] == "" and [float(v) for v in rows[1][1:5]] == seq.gt_boxes[0].tolist()
+    assert all(r[6] in ("tracking", "lost") and float(r[5]) >= 0 for r in rows[2:])
+    boxes = np.array([[float(v) for v in r[1:5]] for r in rows[1:]])
+    # the gyro prior keeps the target under this shake (IoU > 0.3 on every frame)
+    assert iou(boxes, seq.gt_boxes).min() > 0.3
+    # --gt prints the evaluation table with the scores of the CSV's boxes
+    s = score_sequence(boxes, seq.gt_boxes)
+    assert "AO%" in printed and f"{100 * s.average_overlap:6.1f}" in printed and "iemd+g" in printed
+    # output bag: Detection2DArray + DiagnosticArray per image, stamped and logged like the images
+    out = read_all(tmp_path / "out")
+    inp = read_all(bags / "shaky")
+    dets, diags = by_topic(out, DETECTIONS_TOPIC), by_topic(out, DIAGNOSTICS_TOPIC)
+    assert len(dets) == len(diags) == N
+    np.testing.assert_array_equal(stamps(dets), seq.frame_stamps_ns)
+    img_log = [t for topic, _, t, _ in inp if topic == DEFAULT_TOPICS["image"]]
+    assert [t for topic, _, t, _ in out if topic == DETECTIONS_TOPIC] == img_log
+    for k, (d, r) in enumerate(zip(dets, rows[1:])):
+        if r[6] in ("tracking", "init"):
+            c = d.detections[0].bbox
+            np.testing.assert_allclose(bbox_to_box(c.center.position.x, c.center.position.y, c.size_x, c.size_y),
+                                       [float(v) for v in r[1:5]], atol=1e-9)
+            assert d.detections[0].results[0].hypothesis.class_id == "target"
+        else:
+            assert d.detections == []                          # lost: no detection, as the node
+    assert {s.name for s in diags[-1].status} >= {"iemd_tracker: tracking", "iemd_tracker: imu"}
+    cap = cv2.VideoCapture(str(tmp_path / "v.mp4"))
+    assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == N and abs(cap.get(cv2.CAP_PROP_FPS) - 30.0) < 0.5
+    ok, frame = cap.read()
+    assert ok and frame.shape == (240, 320, 3)
+
+
+def test_gyro_matters_and_no_gyro(seq, bags):
+    with_g = replay(bags / "shaky", seq.gt_boxes[0])
+    without = replay(bags / "shaky", seq.gt_boxes[0], use_gyro=False)
+    assert with_g.gyro_used == N - 1 and without.gyro_used == 0
+    assert all(r.gyro_box is not None for r in with_g.results[1:]) and all(r.gyro_box is None for r in without.results)
+    # the prior moves the search to the rotated target: a better mean overlap (the size of the gain is
+    # the demo's figure, test_demo)
+    assert np.mean(iou(with_g.boxes, seq.gt_boxes)) > np.mean(iou(without.boxes, seq.gt_boxes))
+
+
+def test_formats_agree(seq, bags, tmp_path):
+    """mcap, sqlite3 and ROS 1 bags of the same data replay identically."""
+    ref = replay(bags / "shaky", seq.gt_boxes[0], use_gyro=True)
+    for fmt, name in (("sqlite3", "s"), ("ros1", "r.bag")):
+        make_bag(seq, tmp_path / name, fmt)
+        res = replay(tmp_path / name, seq.gt_boxes[0])
+        np.testing.assert_array_equal(res.boxes, ref.boxes)
+        assert [r.emd for r in res.results[1:]] == [r.emd for r in ref.results[1:]]
+
+
+@pytest.mark.slow
+def test_ros1_converted_matches_ros2_desk(imu_root, tmp_path):
+    """A ROS 1 bag of the CMU desk data, converted by rosbags-convert (--dst-typestore ros2_jazzy),
+    replays with the same CSV as the ROS 2 bag made directly (and as the ROS 1 bag read directly)."""
+    src = source_from_folder(imu_root / "cmu_hwangbo_desk")
+    write_bag(src, tmp_path / "desk.bag", "ros1", count=8)
+    write_bag(src, tmp_path / "desk_ros2", "mcap", count=8)
+    conv = shutil.which("rosbags-convert", path=str(Path(sys.executable).parent)) or "rosbags-convert"
+    out = subprocess.run([conv, "--src", str(tmp_path / "desk.bag"), "--dst", str(tmp_path / "desk_conv"),
+                          "--dst-typestore", "ros2_jazzy"], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    conv_msgs = read_all(tmp_path / "desk_conv")
+    info = by_topic(conv_msgs, DEFAULT_TOPICS["camera_info"])[0]
+    assert hasattr(info, "k") and not hasattr(info, "K")        # ROS 2 field names after conversion
+    init = ",".join(repr(float(v)) for v in src.gt_boxes[0])
+    csvs = {}
+    for name in ("desk_ros2", "desk_conv", "desk.bag"):
+        csvs[name] = tmp_path / f"{name}.csv"
+        assert main([str(tmp_path / name), "--init", init, "--csv", str(csvs[name])]) == 0
+    ref = csvs["desk_ros2"].read_bytes()
+    assert csvs["desk_conv"].read_bytes() == ref and csvs["desk.bag"].read_bytes() == ref
+    assert len(_rows(csvs["desk_ros2"])) == 9
+
+
+def _bag_with(path, *, image_topics=("/cam/image",), imu=False, info=False, bad_step_at=None, n=4, seq=None):
+    """A hand-made bag: frames of ``seq`` on each image topic, optionally IMU / camera info."""
+    with BagWriter(path, "mcap") as bag:
+        for t in image_topics:
+            bag.add_topic(t, "sensor_msgs/msg/Image")
+        if imu:
+            bag.add_topic("/imu", "sensor_msgs/msg/Imu")
+        for k in range(n):
+            ts = int(seq.frame_stamps_ns[k])
+            f = seq.frames[k]
+            for topic in image_topics:
+                step = 960 if k != bad_step_at else 900
+                msg = bag.msg("sensor_msgs/msg/Image")(header=header(bag, topic, ts, "cam"), height=240, width=320,
+                                                       encoding="bgr8", is_bigendian=0, step=step,
+                                                       data=f.reshape(-1))
+                bag.write(topic, ts, msg)
+
+
+def test_no_imu_warns_and_tracks_without_gyro(seq, tmp_path, capsys):
+    _bag_with(tmp_path / "noimu", seq=seq)
+    assert main([str(tmp_path / "noimu"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 0
+    err = capsys.readouterr().err
+    assert "warning" in err and "no sensor_msgs/msg/Imu topic" in err and "without the gyro prior" in err
+    assert len(_rows(tmp_path / "o.csv")) == 5
+    # IMU but no camera info: also a warning, no prior
+    res = replay(tmp_path / "noimu", seq.gt_boxes[0], warn=lambda s: None)
+    assert res.gyro_used == 0 and res.warnings
+
+
+def test_topic_selection_and_malformed_image(seq, tmp_path, capsys):
+    _bag_with(tmp_path / "two", image_topics=("/a/image", "/b/image"), seq=seq, bad_step_at=2)
+    assert main([str(tmp_path / "two"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "2 sensor_msgs/msg/Image topics" in err and "--image-topic" in err and err.count("\n") == 0
+    assert main([str(tmp_path / "two"), "--init", _init(seq), "--image-topic", "/b/image",
+                 "--csv", str(tmp_path / "o.csv")]) == 0
+    rows = _rows(tmp_path / "o.csv")
+    assert [r[6] for r in rows[1:]][2] == "malformed" and rows[3][1] == ""   # the bad image: a row, no box
+    assert rows[4][6] in ("tracking", "lost")                                 # and tracking goes on
+
+
+def _truncate(path: Path, frac: float = 0.5) -> None:
+    os.truncate(path, int(path.stat().st_size * frac))
+
+
+def test_bad_input(seq, bags, tmp_path, capsys):
+    make_bag(seq, tmp_path / "m")
+    make_bag(seq, tmp_path / "s", "sqlite3")
+    make_bag(seq, tmp_path / "r.bag", "ros1")
+    _truncate(next((tmp_path / "m").glob("*.mcap")))
+    _truncate(next((tmp_path / "s").glob("*.db3")))
+    _truncate(tmp_path / "r.bag")
+    with BagWriter(tmp_path / "imu_only", "mcap") as bag:
+        bag.add_topic("/imu", "sensor_msgs/msg/Imu")
+    (tmp_path / "not_a_bag").mkdir()
+    init = _init(seq)
+    cases = [
+        ([str(tmp_path / "missing"), "--init", init], "does not exist"),
+        ([str(tmp_path / "m"), "--init", init], "truncated or corrupt"),
+        ([str(tmp_path / "s"), "--init", init], "truncated or corrupt"),
+        ([str(tmp_path / "r.bag"), "--init", init], "truncated or corrupt"),
+        ([str(tmp_path / "not_a_bag"), "--init", init], "no metadata.yaml"),
+        ([str(tmp_path / "imu_only"), "--init", init], "has no sensor_msgs/msg/Image topic"),
+        ([str(bags / "shaky"), "--init", init, "--image-topic", DEFAULT_TOPICS["imu"]], "expected sensor_msgs/msg/Image"),
+        ([str(bags / "shaky"), "--init", init, "--imu-topic", DEFAULT_TOPICS["image"]], "expected sensor_msgs/msg/Imu"),
+        ([str(bags / "shaky"), "--init", init, "--camera-info-topic", "/nope"], "is not in the bag"),
+        ([str(bags / "shaky"), "--init", "400,10,20,20"], "outside the 320x240 image"),
+        ([str(bags / "shaky"), "--init", "10,10,0,20"], "W, H > 0"),
+        ([str(bags / "shaky"), "--init", "10,10,20"], "X,Y,W,H"),
+        ([str(bags / "shaky"), "--init", init, "--gt", str(tmp_path / "none.txt")], "cannot read ground truth"),
+    ]
+    for argv, text in cases:
+        csv_path = tmp_path / "o.csv"
+        assert main(argv + ["--csv", str(csv_path)]) == 2, argv
+        err = capsys.readouterr().err.strip()
+        assert err.startswith("iemd-replay: error:") and err.count("\n") == 0 and text in err, (argv, err)
+        assert not csv_path.exists()                        # no output on bad input
+    # a ground truth of the wrong length: also exit 2
+    write_gt(tmp_path / "short.txt", seq.gt_boxes[:3])
+    assert main([str(bags / "shaky"), "--init", init, "--csv", str(tmp_path / "o.csv"), "--gt",
+                 str(tmp_path / "short.txt")]) == 2
+    assert "3 boxes for 10 images" in capsys.readouterr().err
+
+
+def test_cli_process_no_traceback(seq, tmp_path):
+    """The real process on a truncated bag: exit status 2, one stderr line, no traceback."""
+    make_bag(seq, tmp_path / "m", count=3)
+    _truncate(next((tmp_path / "m").glob("*.mcap")), 0.7)
+    out = subprocess.run([sys.executable, "-m", "iemd_ros.replay", str(tmp_path / "m"), "--init", _init(seq),
+                          "--csv", str(tmp_path / "o.csv")], capture_output=True, text=True, timeout=120,
+                         env={**os.environ, "PYTHONPATH": str(REPO)})
+    assert out.returncode == 2 and "Traceback" not in out.stderr and out.stderr.strip().count("\n") == 0
+    assert "truncated or corrupt" in out.stderr
+
+
+def test_node_parameter_file_as_config(seq, bags, tmp_path):
+    """--config takes the node's parameter file (config/tracker.yaml); its pipeline keys apply."""
+    import yaml
+
+    params = yaml.safe_load((REPO / "config" / "tracker.yaml").read_text())
+    node = next(iter(params))
+    params[node]["ros__parameters"]["use_gyro"] = False
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(params))
+    assert main([str(bags / "shaky"), "--init", _init(seq), "--csv", str(tmp_path / "a.csv"),
+                 "--config", str(tmp_path / "p.yaml")]) == 0
+    assert main([str(bags / "shaky"), "--init", _init(seq), "--csv", str(tmp_path / "b.csv"), "--no-gyro"]) == 0
+    assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
+    params[node]["ros__parameters"]["imu_wait_ms"] = -1.0
+    (tmp_path / "bad.yaml").write_text(yaml.safe_dump(params))
+    assert main([str(bags / "shaky"), "--init", _init(seq), "--csv", str(tmp_path / "c.csv"),
+                 "--config", str(tmp_path / "bad.yaml")]) == 2
+
+
+def test_first_images_malformed(seq, tmp_path, capsys):
+    """As the node with initial_box: init on the first decodable image; none decodable -> exit 2."""
+    _bag_with(tmp_path / "bad0", seq=seq, bad_step_at=0)
+    res = replay(tmp_path / "bad0", seq.gt_boxes[1], warn=lambda s: None)
+    assert res.results[0].rejected.startswith("malformed") and res.results[1].stamp_ns == seq.frame_stamps_ns[1]
+    assert res.results[1].box == tuple(seq.gt_boxes[1])
+    with BagWriter(tmp_path / "allbad", "mcap") as bag:
+        bag.add_topic("/cam", "sensor_msgs/msg/Image")
+        bag.write("/cam", 5, bag.msg("sensor_msgs/msg/Image")(header=header(bag, "/cam", 5, "c"), height=2, width=2,
+                                                              encoding="yuv422", is_bigendian=0, step=4,
+                                                              data=np.zeros(8, np.uint8)))
+    assert main([str(tmp_path / "allbad"), "--init", "0,0,1,1", "--csv", str(tmp_path / "o.csv")]) == 2
+    err = capsys.readouterr().err
+    assert "could be decoded" in err and "unsupported image encoding 'yuv422'" in err
+
+
+def test_imu_wait_is_bag_time(seq, tmp_path):
+    """A frame waits for the gyro at most imu_wait_ms of bag (log) time: an IMU logged 40 ms after its
+    stamp is too late for the default 15 ms (no prior), in time for 100 ms (prior on every frame)."""
+    from iemd_ros.bag_make import _camera_info_msg, _image_msg, _imu_msg
+    from iemd_ros.pipeline import PipelineConfig
+
+    t_cam = seq.gyro_t_ns - seq.time_offset_ns
+    events = [(int(t) + 40_000_000, 0, i) for i, t in enumerate(t_cam)]
+    events += [(int(t), 1, k) for k, t in enumerate(seq.frame_stamps_ns)] + \
+              [(int(t) + 1, 2, k) for k, t in enumerate(seq.frame_stamps_ns)]
+    with BagWriter(tmp_path / "late", "mcap") as bag:
+        for topic, typ in (("/imu", "sensor_msgs/msg/Imu"), ("/info", "sensor_msgs/msg/CameraInfo"),
+                           ("/img", "sensor_msgs/msg/Image")):
+            bag.add_topic(topic, typ)
+        for log_t, kind, i in sorted(events):
+            if kind == 0:
+                bag.write("/imu", log_t, _imu_msg(bag, "/imu", int(t_cam[i]), "imu", seq.gyro[i], None))
+            elif kind == 1:
+                bag.write("/info", log_t, _camera_info_msg(bag, "/info", log_t, "cam", seq.camera, 320, 240))
+            else:
+                bag.write("/img", log_t, _image_msg(bag, "/img", log_t - 1, "cam", seq.frames[i], "bgr8"))
+    short = replay(tmp_path / "late", seq.gt_boxes[0], config=PipelineConfig(imu_wait_ms=15.0))
+    long = replay(tmp_path / "late", seq.gt_boxes[0], config=PipelineConfig(imu_wait_ms=100.0))
+    assert short.gyro_used == 0 and long.gyro_used == N - 1
+    assert "not covering" in short.results[-1].gyro_reason
