@@ -40,6 +40,18 @@ def isolated_ros_env():
                 os.environ[k] = v
 
 
+@contextmanager
+def ros_context():
+    """An rclpy context on an isolated domain (see isolated_ros_env), shut down afterwards."""
+    with isolated_ros_env() as domain:
+        context = rclpy.Context()
+        rclpy.init(context=context, domain_id=domain)
+        try:
+            yield context
+        finally:
+            rclpy.try_shutdown(context=context)
+
+
 def level(status) -> int:
     lv = status.level
     return lv[0] if isinstance(lv, (bytes, bytearray)) else int(lv)

@@ -21,7 +21,7 @@ pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy  # noqa: E402
-from ros_harness import isolated_ros_env, spinning  # noqa: E402
+from ros_harness import ros_context, spinning  # noqa: E402
 from sensor_msgs.msg import CameraInfo, Image, Imu  # noqa: E402
 from vision_msgs.msg import Detection2DArray  # noqa: E402
 
@@ -39,11 +39,8 @@ IMU_WAIT_MS = 1000.0
 
 @pytest.fixture(scope="module")
 def ctx():
-    with isolated_ros_env() as domain:
-        context = rclpy.Context()
-        rclpy.init(context=context, domain_id=domain)
+    with ros_context() as context:
         yield context
-        rclpy.try_shutdown(context=context)
 
 
 @pytest.fixture(scope="module")

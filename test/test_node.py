@@ -11,7 +11,7 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
-from ros_harness import FRAME_ID, Driver, isolated_ros_env, level, spinning, stamp_ns, values  # noqa: E402
+from ros_harness import FRAME_ID, Driver, level, ros_context, spinning, stamp_ns, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
 
@@ -26,11 +26,8 @@ N = 40
 
 @pytest.fixture(scope="module")
 def ctx():
-    with isolated_ros_env() as domain:
-        context = rclpy.Context()
-        rclpy.init(context=context, domain_id=domain)
+    with ros_context() as context:
         yield context
-        rclpy.try_shutdown(context=context)
 
 
 @pytest.fixture(scope="module")
