@@ -154,6 +154,15 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge, warm):
     return codes
 
 
+def compile_solver() -> None:
+    """JIT-compile the solver now (or load it from numba's on-disk cache).
+
+    The first call in a fresh environment compiles for seconds; a node or a
+    replay calls this at start-up so the first frames are not dropped for it.
+    """
+    SparseCoder(np.eye(2), 0.1).encode(np.ones((2, 1)), warm=np.ones((2, 1)))
+
+
 class SparseCoder:
     """Codes patch vectors against a fixed dictionary (Gram matrix cached).
 
