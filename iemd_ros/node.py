@@ -271,12 +271,8 @@ class TrackerNode(Node):
     def _on_imu(self, msg: Imu) -> None:
         self._last_imu_wall = time.monotonic()
         t = stamp_to_ns(msg.header.stamp.sec, msg.header.stamp.nanosec)
-        if msg.angular_velocity_covariance[0] == -1.0:
-            self.pipeline.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
-            self._warn("IMU message without angular velocity (covariance[0] = -1)")
-            return
         w = msg.angular_velocity
-        if not self.pipeline.add_imu(t, (w.x, w.y, w.z)):
+        if not self.pipeline.add_imu_message(t, (w.x, w.y, w.z), msg.angular_velocity_covariance[0]):
             self._warn(self.pipeline.last_reasons()["imu_reason"])
         with self._cond:
             self._cond.notify_all()

@@ -346,6 +346,13 @@ class TrackingPipeline:
             self._imu_bad_run = 0
             return True
 
+    def add_imu_message(self, t_ns: int, angular_velocity_xyz, angular_velocity_covariance0: float) -> bool:
+        """A sensor_msgs/Imu's rates: REP 145's covariance[0] = -1 means "no angular velocity"."""
+        if angular_velocity_covariance0 == -1.0:
+            self.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
+            return False
+        return self.add_imu(t_ns, angular_velocity_xyz)
+
     def note_bad_imu(self, reason: str) -> None:
         """Count an IMU message that carries no usable rate (e.g. covariance[0] = -1: no gyro)."""
         with self._lock:

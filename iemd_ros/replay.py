@@ -395,11 +395,8 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
                     pending.append(_Frame(log_t, stamp, msg.header.frame_id, None, str(exc)))
             elif conn.topic == topics.imu:
                 imu_seen += 1
-                if msg.angular_velocity_covariance[0] == -1.0:      # as the node: no angular velocity
-                    pipe.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
-                else:
-                    av = msg.angular_velocity
-                    pipe.add_imu(stamp_ns(msg.header), (av.x, av.y, av.z))
+                av = msg.angular_velocity
+                pipe.add_imu_message(stamp_ns(msg.header), (av.x, av.y, av.z), msg.angular_velocity_covariance[0])
             else:
                 try:
                     pipe.set_camera(_camera_from_msg(msg))
