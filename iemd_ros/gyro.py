@@ -99,9 +99,26 @@ def local_prior(box, H, camera: CameraModel | None = None) -> tuple[np.ndarray, 
     src = box_grid(box)
     if camera is None or not camera.has_distortion:
         return np.asarray(H, float) / H[2, 2], 0.0
+    return _fit_prior(box, src, _warp_grid(box, src, H, camera))
+
+
+def predict_box(box, H, camera: CameraModel | None = None) -> np.ndarray:
+    """Lens-aware predicted box in frame k of ``box`` (frame k-1).
+
+    The centre is the exact image of the box centre; the width/height are the mean lengths of the
+    mapped top/bottom and left/right edges (so a camera roll moves but does not inflate the box).
+    """
+    return _box_from_grid(warp_points(box_grid(box), H, camera))
+
+
+def _warp_grid(box, src, H, camera) -> np.ndarray:
     dst = warp_points(src, H, camera)
     if not np.all(np.isfinite(dst)):
         raise ValueError(f"box {np.asarray(box).tolist()} maps outside the lens model's valid region")
+    return dst
+
+
+def _fit_prior(box, src, dst) -> tuple[np.ndarray, float]:
     G, _ = cv2.findHomography(src, dst, 0)
     if G is None:
         raise ValueError(f"could not fit a homography to the lens-aware mapping of box {np.asarray(box).tolist()}")
@@ -113,13 +130,7 @@ def local_prior(box, H, camera: CameraModel | None = None) -> tuple[np.ndarray, 
     return G, res
 
 
-def predict_box(box, H, camera: CameraModel | None = None) -> np.ndarray:
-    """Lens-aware predicted box in frame k of ``box`` (frame k-1).
-
-    The centre is the exact image of the box centre; the width/height are the mean lengths of the
-    mapped top/bottom and left/right edges (so a camera roll moves but does not inflate the box).
-    """
-    g = warp_points(box_grid(box), H, camera)
+def _box_from_grid(g) -> np.ndarray:
     tl, tr, br, bl, c = g[0], g[1], g[2], g[3], g[8]
     w = 0.5 * (np.hypot(*(tr - tl)) + np.hypot(*(br - bl)))
     h = 0.5 * (np.hypot(*(bl - tl)) + np.hypot(*(br - tr)))
@@ -264,8 +275,14 @@ class GyroPredictor:
         if box is None:
             return GyroPrediction(integ, integ.R, H, H, None, integ.reason)
         try:
-            prior, res = local_prior(box, H, self.camera)
-            pbox = predict_box(box, H, self.camera)
+            # The lens-aware grid is mapped once for both the prior and the predicted box.
+            src = box_grid(box)
+            dst = _warp_grid(box, src, H, self.camera)
+            if self.camera.has_distortion:
+                prior, res = _fit_prior(box, src, dst)
+            else:
+                prior, res = H / H[2, 2], 0.0
+            pbox = _box_from_grid(dst)
         except ValueError as exc:       # box far outside the lens model's valid region
             return GyroPrediction(integ, integ.R, H, None, None, f"no gyro prior at this box: {exc}")
         return GyroPrediction(integ, integ.R, H, prior, pbox, integ.reason, res)
