@@ -117,7 +117,6 @@ class _Descent:
 
     center: np.ndarray  # window centre, image pixels
     emd: float
-    model: CandidateModel | None = None  # candidate model at the centre
     iterations: int = 0
     codings: int = 1  # candidate models built (each sparse-codes one window)
     warnings: int = 0
@@ -281,7 +280,7 @@ class IemdTracker:
         half = np.asarray(size, dtype=np.float64) / 2.0
         model = self._candidate(pyramid, center, size, coarse)
         emd, grad, sol = self._evaluate(model, coarse)
-        state = _Descent(center=model.center, emd=emd, model=model,
+        state = _Descent(center=model.center, emd=emd,
                          warnings=int(sol is not None and not sol.optimal))
         step = cfg.step_px * (2.0 if coarse else 1.0)
         while state.iterations < cfg.n_iter and step >= cfg.min_step_px:
@@ -295,7 +294,7 @@ class IemdTracker:
             state.codings += 1
             state.warnings += int(s_try is not None and not s_try.optimal)
             if e_try < state.emd:
-                state.center, state.emd, state.model, grad = trial.center, e_try, trial, g_try
+                state.center, state.emd, grad = trial.center, e_try, g_try
             else:
                 step *= 0.5
         return state
