@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from .conversions import ns_to_stamp, stamp_to_ns
-from .evaluation import _Parser as CliParser  # noqa: F401  (argparse errors -> _UsageError, re-exported)
-from .evaluation import _UsageError as UsageError
+from .evaluation import CliParser  # noqa: F401  (argparse errors -> UsageError, re-exported)
+from .evaluation import UsageError
 
 __all__ = ["IMAGE_TYPE", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE", "DIAGNOSTICS_TYPE", "FORMATS",
            "BagError", "BagWriter", "CliParser", "Progress", "Topics", "UsageError", "camera_info_fields",

@@ -51,7 +51,7 @@ from .bag_io import (CAMERA_INFO_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFI
                      CliParser, camera_info_fields, cli_main, header)
 from .camera import CameraModel
 from .otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
-from .recordings import _s_to_ns, load_recording
+from .recordings import seconds_to_ns, load_recording
 
 __all__ = ["BagSource", "source_from_folder", "source_from_synthetic", "write_bag", "main",
            "DEFAULT_TOPICS", "ENCODINGS"]
@@ -99,7 +99,7 @@ def _frame_rate_stamps(n: int, fps: float) -> np.ndarray:
 
 def _read_table(path: Path, min_cols: int, what: str) -> tuple[np.ndarray, np.ndarray]:
     """Rows of a CSV/whitespace file (``#`` comments and a non-numeric header skipped): the first
-    column as exact integer ns (decimal seconds, :func:`iemd_ros.recordings._s_to_ns`) and the other
+    column as exact integer ns (decimal seconds, :func:`iemd_ros.recordings.seconds_to_ns`) and the other
     columns (up to 6) as floats."""
     try:
         text = path.read_text()
@@ -118,7 +118,7 @@ def _read_table(path: Path, min_cols: int, what: str) -> tuple[np.ndarray, np.nd
             raise ValueError(f"{path}:{n}: not a number in {what} line {line!r}") from None
         if len(vals) < min_cols or not all(np.isfinite(vals[:1])):
             raise ValueError(f"{path}:{n}: {what} needs at least {min_cols} columns, got {line!r}")
-        times.append(_s_to_ns(parts[0]))
+        times.append(seconds_to_ns(parts[0]))
         values.append(vals[1:7])
     if not times:
         raise ValueError(f"{path}: no {what} rows")

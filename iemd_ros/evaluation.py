@@ -212,12 +212,12 @@ def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
     return "\n".join(lines)
 
 
-class _Parser(argparse.ArgumentParser):
+class CliParser(argparse.ArgumentParser):
     def error(self, message: str):  # one readable line, exit 2 (no usage dump)
-        raise _UsageError(message)
+        raise UsageError(message)
 
 
-class _UsageError(Exception):
+class UsageError(Exception):
     pass
 
 
@@ -239,7 +239,7 @@ def _positive_int(text: str) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="iemd-eval", description=__doc__.split("\n\n")[0],
+    p = CliParser(prog="iemd-eval", description=__doc__.split("\n\n")[0],
                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("inputs", nargs="*", metavar="ROOT_OR_SEQ",
                    help="OTB root folder(s) and/or sequence folder(s); default ../shared/data/otb")
@@ -355,7 +355,7 @@ def main(argv: list[str] | None = None) -> int:
         sequences = collect_sequences(args.inputs, args.sequences)
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
-    except (_UsageError, ValueError) as exc:
+    except (UsageError, ValueError) as exc:
         print(f"iemd-eval: error: {exc}", file=sys.stderr)
         return 2
     t_start = time.perf_counter()

@@ -67,7 +67,7 @@ def _ms_to_ns(v) -> np.ndarray:
     return np.asarray(v, dtype=np.int64) * 1_000_000
 
 
-def _s_to_ns(text: str) -> int:
+def seconds_to_ns(text: str) -> int:
     try:
         return int((Decimal(text.strip()) * 1_000_000_000).to_integral_value())
     except InvalidOperation as exc:
@@ -151,9 +151,9 @@ def load_phone(root) -> Recording:
     root = Path(root)
     frames = _rows(root / "derived_frames.csv")
     files = [root / r[0] for r in frames]
-    stamps = np.array([_s_to_ns(r[2]) for r in frames], dtype=np.int64)
+    stamps = np.array([seconds_to_ns(r[2]) for r in frames], dtype=np.int64)
     g = _rows(root / "derived_gyro_camframe.csv")
-    imu_t = np.array([_s_to_ns(r[0]) for r in g], dtype=np.int64)
+    imu_t = np.array([seconds_to_ns(r[0]) for r in g], dtype=np.int64)
     gyro = np.array([[float(v) for v in r[1:4]] for r in g])
     path = _need(root / "derived_camera.yaml")
     try:

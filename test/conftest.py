@@ -23,3 +23,12 @@ def otb_root() -> Path:
 def imu_root() -> Path:
     """Folder of camera + gyro recordings (../shared/data/imu)."""
     return _need(DATA / "imu")
+
+
+@pytest.fixture(scope="module")
+def ctx():
+    """An rclpy context on an isolated, localhost-only domain, for the ROS tests of one module."""
+    from ros_harness import ros_context  # rclpy is imported only by the tests that need it
+
+    with ros_context() as context:
+        yield context

@@ -21,7 +21,7 @@ pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy  # noqa: E402
-from ros_harness import ros_context, spinning  # noqa: E402
+from ros_harness import spinning  # noqa: E402
 from sensor_msgs.msg import CameraInfo, Image, Imu  # noqa: E402
 from vision_msgs.msg import Detection2DArray  # noqa: E402
 
@@ -35,12 +35,6 @@ IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT
 BOX_TOL_PX = 1e-6
 LIVE_RATE = 0.05  # the node must keep up on a loaded 2-core machine (~100-300 ms per update)
 IMU_WAIT_MS = 1000.0
-
-
-@pytest.fixture(scope="module")
-def ctx():
-    with ros_context() as context:
-        yield context
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
-from ros_harness import FRAME_ID, Driver, level, ros_context, spinning, stamp_ns, values  # noqa: E402
+from ros_harness import FRAME_ID, Driver, level, spinning, stamp_ns, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
 
@@ -22,12 +22,6 @@ from iemd_ros.synthetic import generate  # noqa: E402
 
 OK, WARN, ERROR = 0, 1, 2
 N = 40
-
-
-@pytest.fixture(scope="module")
-def ctx():
-    with ros_context() as context:
-        yield context
 
 
 @pytest.fixture(scope="module")
