@@ -37,10 +37,6 @@ class ImagePyramid:
         while len(self.levels) <= max_levels and min(self.levels[-1].shape) >= 32:
             self.levels.append(cv2.pyrDown(self.levels[-1]))
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.levels[0].shape
-
     def sample(self, center, size, template_size, coarse: int = 0) -> np.ndarray:
         """Resample a window to a (Th, Tw) template; ``template_size`` is (Tw, Th).
 
@@ -83,33 +79,21 @@ class PatchLayout:
             raise ValueError(f"unknown patch normalization {self.normalization!r}")
 
     @property
-    def dim(self) -> int:
-        return self.patch_size[0] * self.patch_size[1]
-
-    @property
     def cells(self) -> tuple[int, int]:
         """Number of patches per row and column of the template."""
         tw, th = self.template_size
         pw, ph = self.patch_size
         return (tw - pw) // self.step + 1, (th - ph) // self.step + 1
 
-    def cell_positions(self, i, j) -> np.ndarray:
-        """(N, 2) normalized centres of lattice cells (i, j): patch top-left at (i, j) * step.
-
-        Cells 0..cells-1 are the window's own patches; other integers continue the
-        lattice outside the window.
-        """
-        tw, th = self.template_size
-        pw, ph = self.patch_size
-        x = (np.asarray(i) * self.step + (pw - 1) / 2 - (tw - 1) / 2) / (tw / 2)
-        y = (np.asarray(j) * self.step + (ph - 1) / 2 - (th - 1) / 2) / (th / 2)
-        return np.column_stack([np.ravel(x), np.ravel(y)]).astype(np.float64)
-
     def positions(self) -> np.ndarray:
         """(N, 2) normalized centres of the window's patches, row-major like :meth:`extract`."""
+        tw, th = self.template_size
+        pw, ph = self.patch_size
         nx, ny = self.cells
         gi, gj = np.meshgrid(np.arange(nx), np.arange(ny))
-        return self.cell_positions(gi, gj)
+        x = (gi * self.step + (pw - 1) / 2 - (tw - 1) / 2) / (tw / 2)
+        y = (gj * self.step + (ph - 1) / 2 - (th - 1) / 2) / (th / 2)
+        return np.column_stack([x.ravel(), y.ravel()]).astype(np.float64)
 
     def extract(self, template: np.ndarray) -> np.ndarray:
         """(N, m*n) appearance vectors epsilon ("normalized pixel values").
