@@ -1,7 +1,7 @@
 """Earth Mover's Distance between target and candidate histograms (section 3).
 
 The transportation problem of eqs. (4)-(8) is solved with POT's network
-simplex (``ot.emd``), which returns the optimal flow and the dual potentials
+simplex (``ot.emd``'s solver ``emd_c``), which returns the optimal flow and the dual potentials
 ``u`` (target bins) and ``v`` (candidate bins) of eq. (dual).  By strong
 duality ``D* = <u, w_T> + <v, w_C>``, so ``v`` is the vector ``M`` of eq. (9)
 that expresses the EMD as a linear function of the candidate weights on the
@@ -13,7 +13,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import ot
+# POT's network simplex without the backend dispatch of ``ot.emd`` around it
+# (measured: 0.17 vs 0.27 ms per 49x49 problem, ~20 solves per frame).
+from ot.lp.emd_wrap import emd_c
+
+_RESULT_MESSAGES = {0: "infeasible", 1: "optimal", 2: "unbounded",
+                    3: "max_iter reached before optimality"}
 
 
 @dataclass
@@ -58,12 +63,15 @@ def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int 
         raise ValueError("EMD weights must be non-negative")
     if abs(w_t.sum() - w_c.sum()) > 1e-9 * max(1.0, w_t.sum()):
         raise ValueError(f"EMD needs equal total weights, got {w_t.sum()} and {w_c.sum()}")
-    flow, log = ot.emd(w_t, w_c, np.ascontiguousarray(cost, dtype=np.float64), numItermax=max_iter, log=True)
-    optimal = int(log.get("result_code", 1)) == 1
-    return EmdSolution(
-        value=float(log["cost"]), flow=flow, u=log["u"], v=log["v"],
-        optimal=optimal, message=str(log.get("warning") or "optimal"),
-    )
+    flow, value, u, v, code = emd_c(w_t, w_c, np.ascontiguousarray(cost, dtype=np.float64), max_iter, 1)
+    # The network simplex drops zero-weight bins and leaves their duals arbitrary;
+    # the tightest feasible ones keep every reduced cost d_uv - u_u - v_v >= 0.
+    if np.any(w_t == 0) and np.any(w_c > 0):
+        u = np.where(w_t > 0, u, (cost[:, w_c > 0] - v[w_c > 0]).min(axis=1))
+    if np.any(w_c == 0) and np.any(w_t > 0):
+        v = np.where(w_c > 0, v, (cost[w_t > 0] - u[w_t > 0, None]).min(axis=0))
+    return EmdSolution(value=float(value), flow=flow, u=u, v=v, optimal=code == 1,
+                       message=_RESULT_MESSAGES.get(int(code), f"solver result code {code}"))
 
 
 def emd_gradient(solution: EmdSolution, dw_c_dy: np.ndarray) -> np.ndarray:

@@ -114,9 +114,11 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge, warm):
                 break
         for _ in range(3 * n_atoms):
             w[:] = b
-            for r in range(n_atoms):
+            for r in range(n_atoms):  # w = b - G a over the non-zeros (G symmetric: rows)
                 if a[r] != 0.0:
-                    w -= gram[:, r] * a[r]
+                    ar = a[r]
+                    for j in range(n_atoms):
+                        w[j] -= gram[r, j] * ar
             j_best = -1
             w_best = tol
             for j in range(n_atoms):
@@ -152,15 +154,6 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge, warm):
                         active[j] = False
         codes[:, n] = a
     return codes
-
-
-def compile_solver() -> None:
-    """JIT-compile the solver now (or load it from numba's on-disk cache).
-
-    The first call in a fresh environment compiles for seconds; a node or a
-    replay calls this at start-up so the first frames are not dropped for it.
-    """
-    SparseCoder(np.eye(2), 0.1).encode(np.ones((2, 1)), warm=np.ones((2, 1)))
 
 
 class SparseCoder:
