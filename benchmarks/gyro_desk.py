@@ -7,8 +7,8 @@ tracker's current window (``GyroPredictor.predict``), integrated from the frame 
 to (after a frame reported lost, the tracker keeps its previous window, so the rotation is
 integrated from that frame).  Scores (iemd_ros.metrics) over the first 100 frames (the paper's
 sequence length) and over the whole sequence, from the init frame on (the init frame included, as
-in OTB); frames whose GT is absent are excluded (the desk GT has none).  The paper's ±10 % scale
-search is the tracker's own setting.
+in OTB); frames whose GT is absent are excluded (the desk GT has none).  Both modes use the
+paper's ±10 % scale search of its gyro experiment (``--scale-range``, TrackerConfig.scale_range).
 
     PYTHONPATH=. .venv/bin/python benchmarks/gyro_desk.py [--frames N] [--imu-root ../shared/data/imu]
 """
@@ -28,11 +28,11 @@ from iemd_ros.recordings import load_recording
 DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu"
 
 
-def run(rec, start: int, stop: int, use_gyro: bool):
+def run(rec, start: int, stop: int, use_gyro: bool, scale_range: float):
     """Tracker boxes for frames start..stop-1 (the init frame gets its GT box), and prior notes."""
-    from iemd_ros import IemdTracker
+    from iemd_ros import IemdTracker, TrackerConfig
 
-    tracker = IemdTracker()
+    tracker = IemdTracker(TrackerConfig(scale_range=scale_range))
     tracker.init(rec.load_frame(start), rec.gt_boxes[start])
     pred = None
     if use_gyro:
@@ -62,6 +62,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--imu-root", type=Path, default=DEFAULT_ROOT)
     ap.add_argument("--frames", type=int, default=0, help="track only this many frames (0: whole sequence)")
+    ap.add_argument("--scale-range", type=float, default=0.1,
+                    help="largest scale change per frame searched (paper's gyro experiment: 0.1)")
     ap.add_argument("--save", type=Path, help="write the boxes of both runs and the GT to this .npz file")
     args = ap.parse_args(argv)
     folder = args.imu_root / "cmu_hwangbo_desk"
@@ -82,7 +84,7 @@ def main(argv=None) -> int:
     results = {}
     for use_gyro in (True, False):
         t0 = time.perf_counter()
-        boxes, n_lost, no_prior = run(rec, start, stop, use_gyro)
+        boxes, n_lost, no_prior = run(rec, start, stop, use_gyro, args.scale_range)
         dt = time.perf_counter() - t0
         results[use_gyro] = boxes
         label = "gyro-aided" if use_gyro else "no gyro"

@@ -11,10 +11,11 @@ the ground distance do not depend on the target's size in pixels.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import cv2
+import numba
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 
 
 def to_gray(frame: np.ndarray) -> np.ndarray:
@@ -37,23 +38,26 @@ class ImagePyramid:
         while len(self.levels) <= max_levels and min(self.levels[-1].shape) >= 32:
             self.levels.append(cv2.pyrDown(self.levels[-1]))
 
-    def sample(self, center, size, template_size, coarse: int = 0) -> np.ndarray:
+    def sample(self, center, size, template_size, coarse: int = 0, angle: float = 0.0) -> np.ndarray:
         """Resample a window to a (Th, Tw) template; ``template_size`` is (Tw, Th).
 
         ``coarse`` samples that many pyramid levels above the anti-aliasing level:
         a smoother template of the same window, for the coarse stage of the
-        search.  Parts outside the image are padded by replicating the border.
+        search.  ``angle`` (radians) rotates the window about its centre: its x
+        axis points along (cos, sin) in the image.  Parts outside the image are
+        padded by replicating the border.
         """
         tw, th = template_size
         sx, sy = size[0] / tw, size[1] / th
         level = int(np.floor(np.log2(max(min(sx, sy), 1.0)))) + coarse
-        level = int(np.clip(level, 0, len(self.levels) - 1))
+        level = min(max(level, 0), len(self.levels) - 1)
         f = 2.0**level
-        # Image point of template pixel u: cx + (u - (Tw-1)/2) * sx; at level l a
-        # full-resolution coordinate x sits at (x + 0.5) / 2^l - 0.5.
-        ox = (center[0] - (tw - 1) / 2 * sx + 0.5) / f - 0.5
-        oy = (center[1] - (th - 1) / 2 * sy + 0.5) / f - 0.5
-        warp = np.array([[sx / f, 0.0, ox], [0.0, sy / f, oy]], dtype=np.float64)
+        # Image point of template pixel u: c + R(angle) ((u - (T-1)/2) * s); at level l
+        # a full-resolution coordinate x sits at (x + 0.5) / 2^l - 0.5.
+        c, si = np.cos(angle), np.sin(angle)
+        linear = np.array([[c * sx, -si * sy], [si * sx, c * sy]]) / f
+        origin = (np.asarray(center, dtype=np.float64) + 0.5) / f - 0.5 - linear @ [(tw - 1) / 2, (th - 1) / 2]
+        warp = np.column_stack([linear, origin])
         return cv2.warpAffine(
             self.levels[level], warp, (int(tw), int(th)),
             flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE,
@@ -87,6 +91,10 @@ class PatchLayout:
 
     def positions(self) -> np.ndarray:
         """(N, 2) normalized centres of the window's patches, row-major like :meth:`extract`."""
+        return self._positions.copy()
+
+    @cached_property
+    def _positions(self) -> np.ndarray:
         tw, th = self.template_size
         pw, ph = self.patch_size
         nx, ny = self.cells
@@ -129,26 +137,79 @@ class PatchLayout:
                 return eps, None
             gy, gx = np.gradient(template)
             return eps, np.stack([self._patches(gx), self._patches(gy)], axis=-1) * scale
-        vectors = self._patches(template)
         if self.normalization == "patch":
-            vectors = vectors - vectors.mean(axis=1, keepdims=True)
-            floor = self.min_contrast * np.sqrt(pw * ph)
+            center, floor = True, self.min_contrast * np.sqrt(pw * ph)
         else:
-            floor = 1e-6
-        norms = np.linalg.norm(vectors, axis=1, keepdims=True)
-        eps = vectors / np.maximum(norms, floor)
-        if not jacobian:
-            return eps, None
-        gy, gx = np.gradient(template)
-        jac = np.stack([self._patches(gx), self._patches(gy)], axis=-1)  # d p / d y
-        if self.normalization == "patch":
-            jac -= jac.mean(axis=1, keepdims=True)
-        unit = (norms > floor)[:, :, None]
-        # d(p/||p||) = (I - eps eps') dp / ||p|| above the floor, dp / floor below it.
-        projected = jac - eps[:, :, None] * np.einsum("nd,ndk->nk", eps, jac)[:, None, :]
-        return eps, np.where(unit, projected, jac) / np.maximum(norms, floor)[:, :, None]
+            center, floor = False, 1e-6
+        if template.shape != self.template_size[::-1]:
+            raise ValueError(f"template of shape {template.shape} does not match {self.template_size[::-1]}")
+        if jacobian:
+            gy, gx = np.gradient(template)
+        else:
+            gx = gy = template
+        eps, jac = _unit_patches(template.ravel(), gx.ravel(), gy.ravel(), self._patch_index, center, floor,
+                                 jacobian)
+        return eps, (jac if jacobian else None)
+
+    @cached_property
+    def _patch_index(self) -> np.ndarray:
+        """(N, m*n) flat template indices of each patch's pixels, row-major patches."""
+        tw, th = self.template_size
+        pw, ph = self.patch_size
+        nx, ny = self.cells
+        corners = (np.arange(ny)[:, None] * self.step * tw + np.arange(nx)[None, :] * self.step).ravel()
+        offsets = (np.arange(ph)[:, None] * tw + np.arange(pw)[None, :]).ravel()
+        return corners[:, None] + offsets[None, :]
 
     def _patches(self, image: np.ndarray) -> np.ndarray:
-        pw, ph = self.patch_size
-        patches = sliding_window_view(image, (ph, pw))[:: self.step, :: self.step]
-        return patches.reshape(-1, pw * ph).astype(np.float64)
+        if image.shape != self.template_size[::-1]:
+            raise ValueError(f"template of shape {image.shape} does not match {self.template_size[::-1]}")
+        return np.asarray(image, dtype=np.float64).ravel()[self._patch_index]
+
+
+@numba.njit(cache=True)
+def _unit_patches(flat, gx, gy, index, center, floor, jacobian):
+    """Patches of a flat template scaled to unit norm (zero mean first if ``center``), and their Jacobian.
+
+    eps = p / max(||p||, floor); above the floor d eps = (I - eps eps') dp / ||p||,
+    below it dp / floor, with dp the patch of the grey-level gradients (also
+    zero-mean if ``center``).  One pass per patch instead of ~30 numpy calls
+    on (49, 64) arrays (0.4 ms -> 0.02 ms per window).
+    """
+    n, d = index.shape
+    eps = np.empty((n, d))
+    jac = np.zeros((n, d, 2)) if jacobian else np.zeros((0, d, 2))
+    for i in range(n):
+        mean = 0.0
+        if center:
+            for j in range(d):
+                mean += flat[index[i, j]]
+            mean /= d
+        norm = 0.0
+        for j in range(d):
+            eps[i, j] = flat[index[i, j]] - mean
+            norm += eps[i, j] * eps[i, j]
+        norm = np.sqrt(norm)
+        scale = max(norm, floor)
+        for j in range(d):
+            eps[i, j] /= scale
+        if not jacobian:
+            continue
+        for k in range(2):
+            g = gx if k == 0 else gy
+            gmean = 0.0
+            if center:
+                for j in range(d):
+                    gmean += g[index[i, j]]
+                gmean /= d
+            dot = 0.0
+            for j in range(d):
+                jac[i, j, k] = g[index[i, j]] - gmean
+                dot += eps[i, j] * jac[i, j, k]
+            if norm > floor:
+                for j in range(d):
+                    jac[i, j, k] = (jac[i, j, k] - eps[i, j] * dot) / scale
+            else:
+                for j in range(d):
+                    jac[i, j, k] /= scale
+    return eps, jac

@@ -27,14 +27,18 @@ class CandidateModel:
 
     def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, coder: SparseCoder | None,
                  n_templates: int, target_eps: np.ndarray, alpha: float, warm: np.ndarray | None = None,
-                 coarse: int = 0):
-        """``coder=None`` (the coarse stage) gives every patch code weight 1: only the kernel weights bins."""
+                 coarse: int = 0, angle: float = 0.0):
+        """``coder=None`` (the coarse stage) gives every patch code weight 1: only the kernel weights bins.
+
+        ``angle``: the window's orientation in the image (see ImagePyramid.sample);
+        positions and gradients are in the window's own axes.
+        """
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
         self.alpha = alpha
-        template = pyramid.sample(self.center, self.size, layout.template_size, coarse)
+        template = pyramid.sample(self.center, self.size, layout.template_size, coarse, angle)
         self.eps, jac = layout.extract_with_jacobian(template)
-        # d epsilon / d (window centre in image pixels): template pixels per image pixel.
+        # d epsilon / d (window centre moved along its axes, image pixels): template pixels per image pixel.
         self.eps_jacobian = jac * (np.asarray(layout.template_size, dtype=np.float64) / self.size)
         self.pos = layout.positions()
         if coder is None:

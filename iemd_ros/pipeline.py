@@ -38,8 +38,7 @@ import numpy as np
 
 from .camera import CameraModel
 from .gyro import GyroConfig, GyroPredictor
-from .sparse_coding import compile_solver
-from .tracker import IemdTracker, TrackerConfig
+from .tracker import IemdTracker, TrackerConfig, compile_jit
 
 __all__ = ["PipelineConfig", "FrameResult", "Status", "TrackingPipeline", "OK", "WARN", "ERROR",
            "gyro_config_from_dict", "gyro_config_to_dict"]
@@ -192,7 +191,7 @@ class TrackingPipeline:
     """Tracker + gyro predictor fed message by message (see the module docstring)."""
 
     def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
-        compile_solver()  # the tracker's JIT: at start-up, not on the first frame
+        compile_jit()  # the tracker's JIT: at start-up, not on the first frame
         self._cfg = config if config is not None else PipelineConfig()
         if not isinstance(self._cfg, PipelineConfig):
             raise ValueError("config must be a PipelineConfig")

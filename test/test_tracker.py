@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import PatchLayout
+from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.metrics import iou
 from iemd_ros.otb import load_sequence, read_frame
 from iemd_ros.template import TemplateDictionary
@@ -102,6 +102,46 @@ def test_prior_moves_the_start_of_the_search():
     assert abs(r_prior.box[0] - 155.0) < 0.5
     assert abs(r_plain.box[0] - 155.0) > 5.0
     assert r_prior.predicted_box[0] == pytest.approx(155.0)
+
+
+def rotated(img, center, degrees):
+    m = cv2.getRotationMatrix2D((float(center[0]), float(center[1])), -degrees, 1.0)  # +: towards +y (image)
+    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
+
+
+def test_window_sampled_at_an_angle_undoes_an_image_rotation():
+    frame = texture(seed=4)
+    center, size = np.array([160.0, 120.0]), np.array([48.0, 40.0])
+    turned = rotated(frame, center, 60.0)
+    gray, gray_turned = (ImagePyramid(to_gray(f)) for f in (frame, turned))
+    reference = gray.sample(center, size, (32, 32))
+    aligned = gray_turned.sample(center, size, (32, 32), angle=np.deg2rad(60.0))
+    unaligned = gray_turned.sample(center, size, (32, 32))
+    assert np.abs(aligned - reference).mean() < 0.2 * np.abs(unaligned - reference).mean()
+
+
+def test_rotation_prior_turns_the_window_and_keeps_the_target():
+    """A 70 degree camera roll about a point off the target: with the exact prior the
+    window follows the target and turns with it; its box is the rotated window's bounding box."""
+    frame0 = texture(seed=5)
+    box = (130.0, 90.0, 50.0, 30.0)
+    pivot, theta = np.array([150.0, 130.0]), np.deg2rad(70.0)
+    frame1 = rotated(frame0, pivot, 70.0)
+    c, s = np.cos(theta), np.sin(theta)
+    H = np.array([[c, -s, pivot[0] - c * pivot[0] + s * pivot[1]],
+                  [s, c, pivot[1] - s * pivot[0] - c * pivot[1]], [0, 0, 1]])
+    config = TrackerConfig(scale_step=0, n_particles=0, update_templates=False)
+    tracker = IemdTracker(config)
+    tracker.init(frame0, box)
+    result = tracker.update(frame1, prior=H)
+    center0 = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
+    expected = H[:2, :2] @ center0 + H[:2, 2]
+    got = np.array(result.box[:2]) + (np.array(result.box[2:]) - 1) / 2
+    assert result.angle == pytest.approx(theta, abs=1e-9)
+    assert np.linalg.norm(got - expected) < 0.5, (got, expected)
+    assert result.box[2:] == pytest.approx((c * 50 + s * 30, s * 50 + c * 30), rel=1e-6)
+    # Measured: EMD 0.005 with the turned window, 0.50 (about the background EMD) without it.
+    assert result.emd < 0.1 * tracker._background_emd and not result.lost
 
 
 def test_target_leaving_the_image_is_reported_lost():
