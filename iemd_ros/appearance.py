@@ -135,7 +135,7 @@ class PatchLayout:
             eps = (self._patches(template) - template.mean()) * scale
             if not jacobian:
                 return eps, None
-            gy, gx = np.gradient(template)
+            gx, gy = _gradient(template)
             return eps, np.stack([self._patches(gx), self._patches(gy)], axis=-1) * scale
         if self.normalization == "patch":
             center, floor = True, self.min_contrast * np.sqrt(pw * ph)
@@ -143,10 +143,7 @@ class PatchLayout:
             center, floor = False, 1e-6
         if template.shape != self.template_size[::-1]:
             raise ValueError(f"template of shape {template.shape} does not match {self.template_size[::-1]}")
-        if jacobian:
-            gy, gx = np.gradient(template)
-        else:
-            gx = gy = template
+        gx, gy = _gradient(template) if jacobian else (template, template)
         eps, jac = _unit_patches(template.ravel(), gx.ravel(), gy.ravel(), self._patch_index, center, floor,
                                  jacobian)
         return eps, (jac if jacobian else None)
@@ -213,3 +210,30 @@ def _unit_patches(flat, gx, gy, index, center, floor, jacobian):
                 for j in range(d):
                     jac[i, j, k] /= scale
     return eps, jac
+
+
+@numba.njit(cache=True)
+def _gradient(image):
+    """(d/dx, d/dy) of a 2-D image as ``np.gradient``: central differences, one-sided at the borders."""
+    h, w = image.shape
+    gx = np.empty((h, w))
+    gy = np.empty((h, w))
+    for i in range(h):
+        for j in range(w):
+            if w == 1:
+                gx[i, j] = 0.0
+            elif j == 0:
+                gx[i, j] = image[i, 1] - image[i, 0]
+            elif j == w - 1:
+                gx[i, j] = image[i, j] - image[i, j - 1]
+            else:
+                gx[i, j] = 0.5 * (image[i, j + 1] - image[i, j - 1])
+            if h == 1:
+                gy[i, j] = 0.0
+            elif i == 0:
+                gy[i, j] = image[1, j] - image[0, j]
+            elif i == h - 1:
+                gy[i, j] = image[i, j] - image[i - 1, j]
+            else:
+                gy[i, j] = 0.5 * (image[i + 1, j] - image[i - 1, j])
+    return gx, gy

@@ -64,23 +64,25 @@ class CandidateModel:
         """
         y = np.asarray(y, dtype=np.float64)
         w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, 1.0, bandwidth)
-        keep = w_c > 0
-        if not keep.any():
+        keep = np.flatnonzero(w_c > 0)
+        if keep.size == 0:
             return np.inf, np.zeros(2), None
         rel = self.pos[keep] - y
-        diff = target_pos[:, None, :] - rel[None, :, :]
-        cost = self.appearance_cost[:, keep] + (1.0 - self.alpha) * (diff**2).sum(-1)
-        solution: EmdSolution = solve_emd(target_weights, w_c[keep], cost)
+        dx = np.subtract.outer(target_pos[:, 0], rel[:, 0])
+        dy = np.subtract.outer(target_pos[:, 1], rel[:, 1])
+        cost = self.appearance_cost.take(keep, axis=1)
+        cost += (1.0 - self.alpha) * (dx * dx + dy * dy)
+        solution: EmdSolution = solve_emd(target_weights, w_c[keep], cost, check=False)
         if gradient == "paper":
             grad = emd_gradient(solution, dw_dy[keep])
         elif gradient == "envelope":
-            grad = envelope_gradient(solution, dw_dy[keep], 2.0 * (1.0 - self.alpha) * diff)
+            grad = envelope_gradient(solution, dw_dy[keep], 2.0 * (1.0 - self.alpha) * np.stack([dx, dy], axis=-1))
         elif gradient == "appearance":
             if np.any(y != 0):
                 raise ValueError("the appearance gradient is defined at the model's own position (y = 0)")
             flow = solution.flow
             residual = flow.T @ target_eps - flow.sum(0)[:, None] * self.eps[keep]
-            grad_px = -2.0 * self.alpha * np.einsum("nd,ndk->k", residual, self.eps_jacobian[keep])
+            grad_px = -2.0 * self.alpha * (residual.ravel() @ self.eps_jacobian[keep].reshape(-1, 2))
             grad = grad_px * self.size / 2.0  # per normalized unit, like the other two
         else:
             raise ValueError(f"unknown gradient {gradient!r}")

@@ -112,6 +112,16 @@ class _Target:
     pos: np.ndarray  # (N_T, 2) normalized positions
     weights: np.ndarray  # w_T (N_T,)
     codes: np.ndarray  # sparse codes against the current dictionary (n_atoms, N_T)
+    bins: tuple = ()  # (pos, eps, weights) of the bins with mass: all the EMD sees (see select)
+
+    def select(self) -> None:
+        """Keep the bins with mass for the EMD (the kernel is zero in the window's corners).
+
+        Zero-mass bins change neither the optimal flow nor the candidate duals;
+        dropping them once saves the solver's filtering on every solve.
+        """
+        keep = np.flatnonzero(self.weights > 0)
+        self.bins = (self.pos[keep], self.eps[keep], self.weights[keep])
 
 
 @dataclass
@@ -164,6 +174,7 @@ class IemdTracker:
         self._coarse_target = _Target(
             eps=self.layout.extract(pyramid.sample(self._center, self._size, cfg.template_size, coarse=1)),
             pos=pos, weights=target_weights(np.ones(len(pos)), pos, cfg.kernel_bandwidth), codes=np.zeros(0))
+        self._coarse_target.select()
         self._frame_index = 0
         self._lost = False
 
@@ -246,19 +257,19 @@ class IemdTracker:
         self._target.codes = codes
         pooled = max_alignment_pooling(codes, len(self.dictionary.templates))
         self._target.weights = target_weights(pooled, self._target.pos, self.config.kernel_bandwidth)
+        self._target.select()
 
     def _candidate(self, pyramid: ImagePyramid, center, size, coarse: bool = False) -> CandidateModel:
         if coarse:
-            return CandidateModel(pyramid, self.layout, center, size, None, 1, self._coarse_target.eps,
+            return CandidateModel(pyramid, self.layout, center, size, None, 1, self._coarse_target.bins[1],
                                   self.config.alpha, coarse=1, angle=self._search_angle)
         return CandidateModel(pyramid, self.layout, center, size, self.dictionary.coder,
-                              len(self.dictionary.templates), self._target.eps, self.config.alpha,
+                              len(self.dictionary.templates), self._target.bins[1], self.config.alpha,
                               warm=self._target.codes, angle=self._search_angle)
 
     def _evaluate(self, model: CandidateModel, coarse: bool = False):
-        target = self._coarse_target if coarse else self._target
-        return model.evaluate(np.zeros(2), self.config.kernel_bandwidth, target.pos, target.eps, target.weights,
-                              self.config.gradient)
+        pos, eps, weights = (self._coarse_target if coarse else self._target).bins
+        return model.evaluate(np.zeros(2), self.config.kernel_bandwidth, pos, eps, weights, self.config.gradient)
 
     def _search(self, pyramid: ImagePyramid, center, size) -> _Descent:
         """Coarse-to-fine Algorithm 1 from one starting point.
