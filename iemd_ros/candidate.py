@@ -26,8 +26,8 @@ class CandidateModel:
     """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``."""
 
     def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, coder: SparseCoder | None,
-                 n_templates: int, target_eps: np.ndarray, alpha: float, warm: np.ndarray | None = None,
-                 coarse: int = 0, angle: float = 0.0):
+                 n_templates: int, target_eps: np.ndarray, alpha: float, coarse: int = 0,
+                 angle: float = 0.0):
         """``coder=None`` (the coarse stage) gives every patch code weight 1: only the kernel weights bins.
 
         ``angle``: the window's orientation in the image (see ImagePyramid.sample);
@@ -44,7 +44,7 @@ class CandidateModel:
         if coder is None:
             self.code_weights = np.ones(len(self.eps))
         else:
-            self.code_weights = max_alignment_pooling(coder.encode(self.eps.T, warm=warm), n_templates)
+            self.code_weights = max_alignment_pooling(coder.encode(self.eps.T), n_templates)
         self.appearance_cost = alpha * appearance_distance(target_eps, self.eps)
 
     def evaluate(self, y, bandwidth: float, target_pos, target_eps, target_weights, gradient: str):

@@ -3,8 +3,7 @@
 OpenCV-style API: ``init(frame, box)`` then ``update(frame, prior=None)``.
 
 Per frame and starting point: build the candidate model at the window
-(resample, cut into patches, sparse-code with the target's codes as warm
-start), solve the EMD, move the window against the EMD gradient, and repeat
+(resample, cut into patches, sparse-code them), solve the EMD, move the window against the EMD gradient, and repeat
 while the EMD decreases (backtracking the step when it does not); then try
 the scale variants at the converged window.
 """
@@ -111,7 +110,6 @@ class _Target:
     eps: np.ndarray  # (N_T, dim) appearance vectors
     pos: np.ndarray  # (N_T, 2) normalized positions
     weights: np.ndarray  # w_T (N_T,)
-    codes: np.ndarray  # sparse codes against the current dictionary (n_atoms, N_T)
     bins: tuple = ()  # (pos, eps, weights) of the bins with mass: all the EMD sees (see select)
 
     def select(self) -> None:
@@ -166,14 +164,14 @@ class IemdTracker:
         self.dictionary = TemplateDictionary(self.layout, cfg.n_templates, cfg.lam,
                                              cfg.forgetting, cfg.reconstruction_lambda)
         self.dictionary.add(template, 0.0, 0)
-        self._target = _Target(eps=np.zeros(0), pos=self.layout.positions(), weights=np.zeros(0), codes=np.zeros(0))
+        self._target = _Target(eps=np.zeros(0), pos=self.layout.positions(), weights=np.zeros(0))
         self._refresh_target(template)
         self._background_emd = self._measure_background_emd(pyramid)
         # Coarse stage: the target window one pyramid level smoother, weighted by the kernel only.
         pos = self.layout.positions()
         self._coarse_target = _Target(
             eps=self.layout.extract(pyramid.sample(self._center, self._size, cfg.template_size, coarse=1)),
-            pos=pos, weights=target_weights(np.ones(len(pos)), pos, cfg.kernel_bandwidth), codes=np.zeros(0))
+            pos=pos, weights=target_weights(np.ones(len(pos)), pos, cfg.kernel_bandwidth))
         self._coarse_target.select()
         self._frame_index = 0
         self._lost = False
@@ -254,7 +252,6 @@ class IemdTracker:
         if template is not None:
             self._target.eps = self.layout.extract(template)
         codes = self.dictionary.coder.encode(self._target.eps.T)
-        self._target.codes = codes
         pooled = max_alignment_pooling(codes, len(self.dictionary.templates))
         self._target.weights = target_weights(pooled, self._target.pos, self.config.kernel_bandwidth)
         self._target.select()
@@ -265,7 +262,7 @@ class IemdTracker:
                                   self.config.alpha, coarse=1, angle=self._search_angle)
         return CandidateModel(pyramid, self.layout, center, size, self.dictionary.coder,
                               len(self.dictionary.templates), self._target.bins[1], self.config.alpha,
-                              warm=self._target.codes, angle=self._search_angle)
+                              angle=self._search_angle)
 
     def _evaluate(self, model: CandidateModel, coarse: bool = False):
         pos, eps, weights = (self._coarse_target if coarse else self._target).bins

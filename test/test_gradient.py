@@ -31,7 +31,7 @@ def model_setup():
     center = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
     model = CandidateModel(ImagePyramid(to_gray(frame1)), tracker.layout, center, np.array(box[2:], float),
                              tracker.dictionary.coder, len(tracker.dictionary.templates), tracker._target.eps,
-                             tracker.config.alpha, tracker._target.codes)
+                             tracker.config.alpha)
     return tracker, model
 
 

@@ -45,19 +45,6 @@ def test_codes_are_optimal_against_perturbations():
         assert np.all(lasso_objective(atoms, signals, other, lam) >= best - 1e-12)
 
 
-def test_warm_start_gives_the_same_codes():
-    atoms, signals = patch_dictionary(seed=2)
-    coder = SparseCoder(atoms, 0.02)
-    cold = coder.encode(signals)
-    perturbed = signals + 0.05 * np.random.default_rng(3).normal(size=signals.shape)
-    expected = coder.encode(perturbed)
-    assert np.allclose(coder.encode(perturbed, warm=cold), expected, atol=1e-10)
-    # Even a poor guess (every atom active) ends at the same optimum.
-    assert np.allclose(coder.encode(perturbed, warm=np.ones_like(cold)), expected, atol=1e-9)
-    with pytest.raises(ValueError, match="warm codes"):
-        coder.encode(signals, warm=cold[:, :3])
-
-
 def test_duplicate_atoms_do_not_break_the_solver():
     atoms, signals = patch_dictionary(seed=4, n_atoms=30)
     doubled = np.hstack([atoms, atoms])  # e.g. two identical templates
