@@ -28,7 +28,7 @@ class TrackerConfig:
     patch_size: tuple[int, int] = (8, 8)  # local patch m x n
     patch_step: int = 4
     normalization: str = "patch"  # grey-level normalization of the patches: see PatchLayout.extract
-    n_templates: int = 3  # L, templates in the dictionary
+    n_templates: int = 1  # L, templates in the dictionary (the paper gives no value; see IemdTracker)
     lam: float = 0.1  # lambda of eq. (lagrange): measured, see the note in sparse_coding.py
     alpha: float = 0.5  # appearance vs spatial weight of the ground distance
     kernel_bandwidth: float = 1.0  # h in normalized window units (1: ellipse inscribed in the window)
@@ -134,7 +134,16 @@ class _Descent:
 
 
 class IemdTracker:
-    """iEMD visual tracker (Yao & Dani): sparse-coding histograms + EMD gradient descent."""
+    """iEMD visual tracker (Yao & Dani): sparse-coding histograms + EMD gradient descent.
+
+    Dictionary size L (``n_templates``; the paper gives no value): L = 1, the
+    template kept up to date by Algorithm 2, measured (benchmarks/tune_tracker.py,
+    all 12 OTB sequences, mean average overlap) 31.9 % against 27.3 % for L = 3,
+    CMU desk with gyro 80.0 % against 74.8 %, and it codes 3x fewer atoms
+    (median update 11.3 vs 13.9 ms in the same run).  Per-sequence figures swing
+    by tens of points with small changes (a tracker that loses the target early
+    scores near zero), so only the 12-sequence mean is used for such choices.
+    """
 
     def __init__(self, config: TrackerConfig | None = None):
         self.config = config if config is not None else TrackerConfig()
