@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import cv2
+import numba
 import numpy as np
 
 __all__ = ["CameraModel"]
@@ -130,24 +131,11 @@ class CameraModel:
         p = self._points(pts)
         if not self.has_distortion:
             return p.copy()
-        k1, k2, p1, p2, k3 = self.D
         xd, yd = self._to_norm(p)
-        x, y = xd.copy(), yd.copy()
-        for _ in range(iterations):
-            fx, fy = self._distort_norm(x, y)
-            ex, ey = fx - xd, fy - yd
-            r2 = x * x + y * y
-            rad = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
-            drad = k1 + r2 * (2 * k2 + 3 * k3 * r2)
-            a = rad + 2 * x * x * drad + 2 * p1 * y + 6 * p2 * x
-            b = 2 * x * y * drad + 2 * p1 * x + 2 * p2 * y
-            d = rad + 2 * y * y * drad + 6 * p1 * y + 2 * p2 * x
-            det = a * d - b * b
-            dx = (d * ex - b * ey) / det
-            dy = (a * ey - b * ex) / det
-            x, y = x - dx, y - dy
-            if np.all(np.abs(dx) + np.abs(dy) < tol):
-                break
+        shape = np.shape(xd)
+        x, y = _undistort_newton(np.ravel(xd).astype(np.float64), np.ravel(yd).astype(np.float64),
+                                 np.asarray(self.D, dtype=np.float64), iterations, tol)
+        x, y = x.reshape(shape), y.reshape(shape)
         fx, fy = self._distort_norm(x, y)
         bad = ~(np.hypot(fx - xd, fy - yd) < 1e-9)
         x, y = np.where(bad, np.nan, x), np.where(bad, np.nan, y)
@@ -170,3 +158,33 @@ class CameraModel:
     def __repr__(self) -> str:
         return (f"CameraModel(fx={self.K[0, 0]:.2f}, fy={self.K[1, 1]:.2f}, cx={self.K[0, 2]:.2f}, "
                 f"cy={self.K[1, 2]:.2f}, D={np.round(self.D, 6).tolist()}, size={self.width}x{self.height})")
+
+
+@numba.njit(cache=True)
+def _undistort_newton(xd, yd, D, iterations, tol):
+    """Newton's method on the plumb_bob model, point by point (normalized coordinates).
+
+    A per-point loop: the numpy version spent ~0.3 ms per call on array
+    overhead for the 9 points of a box grid, every frame.
+    """
+    k1, k2, p1, p2, k3 = D[0], D[1], D[2], D[3], D[4]
+    x = xd.copy()
+    y = yd.copy()
+    for i in range(x.size):
+        for _ in range(iterations):
+            xi, yi = x[i], y[i]
+            r2 = xi * xi + yi * yi
+            rad = 1 + r2 * (k1 + r2 * (k2 + r2 * k3))
+            ex = xi * rad + 2 * p1 * xi * yi + p2 * (r2 + 2 * xi * xi) - xd[i]
+            ey = yi * rad + p1 * (r2 + 2 * yi * yi) + 2 * p2 * xi * yi - yd[i]
+            drad = k1 + r2 * (2 * k2 + 3 * k3 * r2)
+            a = rad + 2 * xi * xi * drad + 2 * p1 * yi + 6 * p2 * xi
+            b = 2 * xi * yi * drad + 2 * p1 * xi + 2 * p2 * yi
+            d = rad + 2 * yi * yi * drad + 6 * p1 * yi + 2 * p2 * xi
+            det = a * d - b * b
+            dx = (d * ex - b * ey) / det
+            dy = (a * ey - b * ex) / det
+            x[i], y[i] = xi - dx, yi - dy
+            if not abs(dx) + abs(dy) >= tol:  # converged (or NaN: the check below rejects it)
+                break
+    return x, y

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 __all__ = [
@@ -123,16 +124,25 @@ def omega_matrix(w) -> np.ndarray:
     return out
 
 
-def _chain(q_steps: np.ndarray) -> np.ndarray:
-    """Ordered product ``q_1 * q_2 * ... * q_n`` by pairwise (tree) reduction, renormalized."""
-    q = q_steps
-    if len(q) == 0:
-        return np.array([1.0, 0.0, 0.0, 0.0])
-    while len(q) > 1:
-        if len(q) % 2:
-            q = np.concatenate([q, [[1.0, 0.0, 0.0, 0.0]]])
-        q = quat_normalize(quat_mul(q[0::2], q[1::2]))
-    return q[0]
+@numba.njit(cache=True)
+def _exp_product(phi):
+    """Ordered product ``exp(phi_1) * ... * exp(phi_n)`` as a unit quaternion with w >= 0.
+
+    One scalar loop (a frame interval has a handful of gyro samples, where
+    numpy's per-call overhead dominated: 0.2 ms per frame).
+    """
+    qw, qx, qy, qz = 1.0, 0.0, 0.0, 0.0
+    for i in range(phi.shape[0]):
+        theta = np.sqrt(phi[i, 0] ** 2 + phi[i, 1] ** 2 + phi[i, 2] ** 2)
+        k = 0.5 - theta ** 2 / 48.0 if theta < 1e-6 else np.sin(0.5 * theta) / theta
+        pw, px, py, pz = np.cos(0.5 * theta), k * phi[i, 0], k * phi[i, 1], k * phi[i, 2]
+        qw, qx, qy, qz = (qw * pw - qx * px - qy * py - qz * pz,
+                          qw * px + qx * pw + qy * pz - qz * py,
+                          qw * py - qx * pz + qy * pw + qz * px,
+                          qw * pz + qx * py - qy * px + qz * pw)
+    n = np.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+    sign = -1.0 if qw < 0 else 1.0
+    return np.array([qw, qx, qy, qz]) * (sign / n)
 
 
 def integrate_rates(t, w, coning: bool = True) -> np.ndarray:
@@ -155,7 +165,7 @@ def integrate_rates(t, w, coning: bool = True) -> np.ndarray:
     phi = 0.5 * h[:, None] * (w[:-1] + w[1:])
     if coning:
         phi = phi + (h ** 2 / 12.0)[:, None] * np.cross(w[:-1], w[1:])
-    return _chain(quat_exp(phi))
+    return _exp_product(phi)
 
 
 def integrate_first_order(t, w) -> np.ndarray:
