@@ -54,7 +54,7 @@ def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int 
 
     Raises ValueError for weights that are negative, not finite or of different totals.
     ``check=False`` skips those checks (a third of the call's time) for callers
-    that build valid inputs themselves, like the candidate model.
+    that build valid inputs with positive weights themselves, like the candidate model.
     """
     w_t = np.asarray(w_t, dtype=np.float64)
     w_c = np.asarray(w_c, dtype=np.float64)
@@ -63,9 +63,10 @@ def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int 
     flow, value, u, v, code = emd_c(w_t, w_c, np.ascontiguousarray(cost, dtype=np.float64), max_iter, 1)
     # The network simplex drops zero-weight bins and leaves their duals arbitrary;
     # the tightest feasible ones keep every reduced cost d_uv - u_u - v_v >= 0.
-    if np.any(w_t == 0) and np.any(w_c > 0):
+    # (Unchecked callers pass positive weights only.)
+    if check and np.any(w_t == 0) and np.any(w_c > 0):
         u = np.where(w_t > 0, u, (cost[:, w_c > 0] - v[w_c > 0]).min(axis=1))
-    if np.any(w_c == 0) and np.any(w_t > 0):
+    if check and np.any(w_c == 0) and np.any(w_t > 0):
         v = np.where(w_c > 0, v, (cost[w_t > 0] - u[w_t > 0, None]).min(axis=0))
     return EmdSolution(value=float(value), flow=flow, u=u, v=v, optimal=code == 1,
                        message=_RESULT_MESSAGES.get(int(code), f"solver result code {code}"))

@@ -43,6 +43,7 @@ import sys
 import time
 from collections import deque
 from dataclasses import dataclass, field, fields, replace
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -277,7 +278,13 @@ def _camera_from_msg(msg) -> CameraModel:
     d = getattr(msg, "d", None)
     if k is None:                                  # ROS 1 field names
         k, d = msg.K, msg.D
-    return camera_model_from_info(k, d, msg.distortion_model, msg.width, msg.height)
+    return _camera_model(tuple(map(float, k)), tuple(map(float, d)), msg.distortion_model, msg.width, msg.height)
+
+
+@lru_cache(maxsize=4)
+def _camera_model(k: tuple, d: tuple, distortion_model: str, width: int, height: int) -> CameraModel:
+    """The model of one CameraInfo content, built once (a bag repeats it with every image: 0.2 ms each)."""
+    return camera_model_from_info(k, d, distortion_model, width, height)
 
 
 def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | None = None,
