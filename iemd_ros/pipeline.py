@@ -164,6 +164,7 @@ class FrameResult:
     scale: float = 1.0
     starts: int = 0
     processing_ms: float = 0.0
+    angle: float = 0.0  # orientation of the tracked window (radians); ``box`` is its bounding box
 
     @property
     def tracking(self) -> bool:
@@ -507,7 +508,7 @@ class TrackingPipeline:
         out = FrameResult(t, self._state, box, emd, score, int(result.iterations), bool(result.lost), result.reason,
                           "", gyro_used, gyro_reason, gyro_box,
                           None if result.predicted_box is None else tuple(float(v) for v in result.predicted_box),
-                          float(result.scale), int(result.starts), ms)
+                          float(result.scale), int(result.starts), ms, float(result.angle))
         self._last_result = out
         return out
 
