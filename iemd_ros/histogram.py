@@ -5,15 +5,16 @@ Epanechnikov profile ``k(x) = max(0, 1 - x)`` of its squared normalized distance
 to the window centre, ``x = ||(c_r - y) / (s h)||^2``.
 
 Bandwidth choice (the paper only says "h is template size"): positions are in
-normalized window units (the window is [-1, 1]^2), and ``h`` defaults to sqrt(2),
-the radius of the circle through the window corners, so every patch of the
-window has positive weight (the corner patches of the 8x8/step-4 layout get
-0.44) and the kernel reaches zero at the window's circumscribed circle.
-Measured (benchmarks/tune_tracker.py, 12 OTB sequences, mean average overlap):
-h = 1.0 (ellipse inscribed in the window, corner patches weightless) 31.9 %,
-1.2: 31.2 %, 1.414: 34.7 %, 1.7: 27.1 %; the spread is about the run-to-run
-swing of single sequences, so sqrt(2) stands on its geometric reason.  ``s``
-is the candidate's relative scale (the scale search enlarges/shrinks the window).
+normalized window units (the window is [-1, 1]^2).  The tracker's default is
+h = 1, the ellipse inscribed in the window (the corner patches of the
+8x8/step-4 layout get no weight: 45 of 49 bins); h = sqrt(2) would reach zero
+at the window's circumscribed circle and weight every patch.  Measured
+(benchmarks/tune_tracker.py and iemd-eval, 12 OTB sequences, mean average
+overlap, L = 1): h = 1.0: 31.9 %; 1.2: 31.2 %; 1.414: 34.7 %; sqrt(2): 28.2 %;
+1.7: 27.1 %.  1.414 and sqrt(2) differ by 6.5 points through single sequences
+(Bolt2 50.6 vs 8.2 %): no value is reliably better, and h = 1 solves smaller
+EMDs.  ``s`` is the candidate's relative scale (the scale search
+enlarges/shrinks the window).
 """
 from __future__ import annotations
 

@@ -31,7 +31,7 @@ class TrackerConfig:
     n_templates: int = 1  # L, templates in the dictionary (the paper gives no value; see IemdTracker)
     lam: float = 0.1  # lambda of eq. (lagrange): measured, see the note in sparse_coding.py
     alpha: float = 0.5  # appearance vs spatial weight of the ground distance
-    kernel_bandwidth: float = 2.0 ** 0.5  # h in normalized window units: see histogram.py
+    kernel_bandwidth: float = 1.0  # h in normalized window units (1: ellipse inscribed in the window)
     n_iter: int = 20  # maximum descent iterations per start
     step_px: float = 2.0  # first step along the descent direction, image pixels
     min_step_px: float = 0.5  # stop when backtracking has halved the step below this
