@@ -165,6 +165,14 @@ class PatchLayout:
 
 
 @numba.njit(cache=True)
+def _patch_mean(flat, pixels):
+    total = 0.0
+    for j in range(pixels.size):
+        total += flat[pixels[j]]
+    return total / pixels.size
+
+
+@numba.njit(cache=True)
 def _unit_patches(flat, gx, gy, index, center, floor, jacobian):
     """Patches of a flat template scaled to unit norm (zero mean first if ``center``), and their Jacobian.
 
@@ -177,11 +185,7 @@ def _unit_patches(flat, gx, gy, index, center, floor, jacobian):
     eps = np.empty((n, d))
     jac = np.zeros((n, d, 2)) if jacobian else np.zeros((0, d, 2))
     for i in range(n):
-        mean = 0.0
-        if center:
-            for j in range(d):
-                mean += flat[index[i, j]]
-            mean /= d
+        mean = _patch_mean(flat, index[i]) if center else 0.0
         norm = 0.0
         for j in range(d):
             eps[i, j] = flat[index[i, j]] - mean
@@ -194,11 +198,7 @@ def _unit_patches(flat, gx, gy, index, center, floor, jacobian):
             continue
         for k in range(2):
             g = gx if k == 0 else gy
-            gmean = 0.0
-            if center:
-                for j in range(d):
-                    gmean += g[index[i, j]]
-                gmean /= d
+            gmean = _patch_mean(g, index[i]) if center else 0.0
             dot = 0.0
             for j in range(d):
                 jac[i, j, k] = g[index[i, j]] - gmean

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import ImagePyramid, to_gray
+from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.candidate import CandidateModel
 from iemd_ros.emd import solve_emd
 from iemd_ros.histogram import candidate_weights
@@ -102,3 +102,22 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     # The pooled code weights also move with the content and are left out of the analytic form.
     assert np.linalg.norm(grad - fd) < 0.25 * np.linalg.norm(fd), (grad, fd)
     assert grad @ fd > 0.95 * np.linalg.norm(grad) * np.linalg.norm(fd)
+
+
+@pytest.mark.parametrize("mode,bound", [("patch", 0.1), ("l2", 0.1), ("window", 0.25)])
+def test_patch_jacobian_matches_finite_differences_of_the_resampled_patches(mode, bound):
+    """d epsilon / d(window shift) of PatchLayout.extract_with_jacobian (numba) on a smooth image.
+    Measured relative errors: patch 0.05-0.06, l2 0.04-0.05, window 0.10-0.17 (its window mean and
+    contrast are treated as constant)."""
+    import cv2
+
+    rng = np.random.default_rng(0)
+    image = cv2.GaussianBlur(rng.uniform(0, 1, (120, 160)).astype(np.float32), (0, 0), 4)
+    pyramid = ImagePyramid((image - image.min()) / (image.max() - image.min()))
+    layout = PatchLayout((32, 32), (8, 8), 4, mode)
+    center, size, h = np.array([80.0, 60.0]), np.array([32.0, 32.0]), 0.05
+    _, jac = layout.extract_with_jacobian(pyramid.sample(center, size, (32, 32)))
+    for k, e in enumerate(np.eye(2)):
+        fd = (layout.extract(pyramid.sample(center + h * e, size, (32, 32)))
+              - layout.extract(pyramid.sample(center - h * e, size, (32, 32)))) / (2 * h)
+        assert np.linalg.norm(jac[..., k] - fd) < bound * np.linalg.norm(fd)
