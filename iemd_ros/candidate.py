@@ -14,6 +14,7 @@ tests use to check the gradients against finite differences.
 """
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from .appearance import ImagePyramid, PatchLayout
@@ -67,23 +68,50 @@ class CandidateModel:
         keep = np.flatnonzero(w_c > 0)
         if keep.size == 0:
             return np.inf, np.zeros(2), None
-        rel = self.pos[keep] - y
-        dx = np.subtract.outer(target_pos[:, 0], rel[:, 0])
-        dy = np.subtract.outer(target_pos[:, 1], rel[:, 1])
-        cost = self.appearance_cost.take(keep, axis=1)
-        cost += (1.0 - self.alpha) * (dx * dx + dy * dy)
+        cost = _transport_cost(self.appearance_cost, keep, np.asarray(target_pos, dtype=np.float64), self.pos, y,
+                               1.0 - self.alpha)
         solution: EmdSolution = solve_emd(target_weights, w_c[keep], cost, check=False)
         if gradient == "paper":
             grad = emd_gradient(solution, dw_dy[keep])
         elif gradient == "envelope":
-            grad = envelope_gradient(solution, dw_dy[keep], 2.0 * (1.0 - self.alpha) * np.stack([dx, dy], axis=-1))
+            diff = target_pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
+            grad = envelope_gradient(solution, dw_dy[keep], 2.0 * (1.0 - self.alpha) * diff)
         elif gradient == "appearance":
             if np.any(y != 0):
                 raise ValueError("the appearance gradient is defined at the model's own position (y = 0)")
             flow = solution.flow
-            residual = flow.T @ target_eps - flow.sum(0)[:, None] * self.eps[keep]
-            grad_px = -2.0 * self.alpha * (residual.ravel() @ self.eps_jacobian[keep].reshape(-1, 2))
+            grad_px = -2.0 * self.alpha * _appearance_contraction(flow.T @ target_eps, flow.sum(0), keep, self.eps,
+                                                                  self.eps_jacobian)
             grad = grad_px * self.size / 2.0  # per normalized unit, like the other two
         else:
             raise ValueError(f"unknown gradient {gradient!r}")
         return solution.value, grad, solution
+
+
+@numba.njit(cache=True)
+def _transport_cost(appearance_cost, keep, target_pos, pos, y, spatial_weight):
+    """d_uv over the kept candidate bins: appearance part + spatial_weight ||c_u - (c_v - y)||^2."""
+    n_t, n_c = appearance_cost.shape[0], keep.size
+    cost = np.empty((n_t, n_c))
+    for j in range(n_c):
+        vx, vy = pos[keep[j], 0] - y[0], pos[keep[j], 1] - y[1]
+        for u in range(n_t):
+            dx, dy = target_pos[u, 0] - vx, target_pos[u, 1] - vy
+            cost[u, j] = appearance_cost[u, keep[j]] + spatial_weight * (dx * dx + dy * dy)
+    return cost
+
+
+@numba.njit(cache=True)
+def _appearance_contraction(transported, received, keep, eps, eps_jacobian):
+    """sum_v (sum_u f_uv eps_u - w_v eps_v) . d eps_v/dy over the kept bins v.
+
+    ``transported`` = F' eps_T (rows: kept bins), ``received`` = F' 1.
+    """
+    out = np.zeros(2)
+    for j in range(keep.size):
+        v = keep[j]
+        for d in range(eps.shape[1]):
+            r = transported[j, d] - received[j] * eps[v, d]
+            out[0] += r * eps_jacobian[v, d, 0]
+            out[1] += r * eps_jacobian[v, d, 1]
+    return out
