@@ -22,7 +22,7 @@ def to_gray(frame: np.ndarray) -> np.ndarray:
     """Grey levels in [0, 1] (float32) of an HxW or HxWx3 (BGR) uint8 frame."""
     if frame.ndim == 3:
         frame = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
-    return frame.astype(np.float32) * np.float32(1.0 / 255.0)
+    return np.multiply(frame, np.float32(1.0 / 255.0), dtype=np.float32)
 
 
 class ImagePyramid:
@@ -34,9 +34,18 @@ class ImagePyramid:
     """
 
     def __init__(self, gray: np.ndarray, max_levels: int = 4):
-        self.levels = [gray]
-        while len(self.levels) <= max_levels and min(self.levels[-1].shape) >= 32:
+        self.levels = [gray]  # built on demand by level(): most frames only need one or two
+        h, w = gray.shape[:2]
+        self.n_levels = 1
+        while self.n_levels <= max_levels and min(h, w) >= 32:
+            h, w = (h + 1) // 2, (w + 1) // 2  # cv2.pyrDown's output size
+            self.n_levels += 1
+
+    def level(self, index: int) -> np.ndarray:
+        """Pyramid level ``index`` (0: the frame), computed with the ones below it on first use."""
+        while len(self.levels) <= index:
             self.levels.append(cv2.pyrDown(self.levels[-1]))
+        return self.levels[index]
 
     def sample(self, center, size, template_size, coarse: int = 0, angle: float = 0.0) -> np.ndarray:
         """Resample a window to a (Th, Tw) template; ``template_size`` is (Tw, Th).
@@ -50,7 +59,7 @@ class ImagePyramid:
         tw, th = template_size
         sx, sy = size[0] / tw, size[1] / th
         level = int(np.floor(np.log2(max(min(sx, sy), 1.0)))) + coarse
-        level = min(max(level, 0), len(self.levels) - 1)
+        level = min(max(level, 0), self.n_levels - 1)
         f = 2.0**level
         # Image point of template pixel u: c + R(angle) ((u - (T-1)/2) * s); at level l
         # a full-resolution coordinate x sits at (x + 0.5) / 2^l - 0.5.
@@ -59,7 +68,7 @@ class ImagePyramid:
         origin = (np.asarray(center, dtype=np.float64) + 0.5) / f - 0.5 - linear @ [(tw - 1) / 2, (th - 1) / 2]
         warp = np.column_stack([linear, origin])
         return cv2.warpAffine(
-            self.levels[level], warp, (int(tw), int(th)),
+            self.level(level), warp, (int(tw), int(th)),
             flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE,
         )
 
