@@ -20,9 +20,10 @@ import threading
 from dataclasses import dataclass
 from enum import Enum
 
+import numba
 import numpy as np
 
-from .rotation import GyroCalibration, integrate_rates, quat_to_rot, rot_to_quat
+from .rotation import GyroCalibration, magnus_product, quat_to_rot, rot_to_quat
 
 __all__ = ["Coverage", "ImuIntegration", "ImuBuffer"]
 
@@ -247,12 +248,8 @@ class ImuBuffer:
             return ImuIntegration(np.eye(3), np.array([1.0, 0.0, 0.0, 0.0]), n_used, Coverage.OK,
                                   "empty window", t0, t1, max_gap)
         # knots: t0, the samples strictly inside, t1 (rates interpolated at the ends)
-        rel = (ts - t0).astype(float) * 1e-9
-        t_end = (t1 - t0) * 1e-9
-        inner = (rel > 0) & (rel < t_end)
-        knots = np.concatenate([[0.0], rel[inner], [t_end]])
-        wk = np.stack([np.interp(knots, rel, ws[:, j]) for j in range(3)], axis=1)
-        q_imu = integrate_rates(knots, wk, coning=coning)
+        q_imu = _window_rotation((ts - t0).astype(float) * 1e-9, np.ascontiguousarray(ws), (t1 - t0) * 1e-9,
+                                 coning)
         R = cal.R_cam_imu @ quat_to_rot(q_imu) @ cal.R_cam_imu.T
         q = rot_to_quat(R)
         if max_gap > self.max_gap_ns:
@@ -266,3 +263,35 @@ class ImuBuffer:
         with self._lock:
             self._merge()
             return dict(self.counts, stored=len(self._t))
+
+
+@numba.njit(cache=True)
+def _window_rotation(rel, ws, t_end, coning):
+    """Quaternion of :func:`iemd_ros.rotation.integrate_rates` over [0, t_end] for samples at ``rel``.
+
+    ``rel`` (s, strictly increasing) brackets the window: rel[0] <= 0 and rel[-1] >= t_end.  The
+    knots are 0, the samples strictly inside and t_end, with the rate interpolated linearly at both
+    ends (as ``np.interp``).  One compiled pass: the numpy version spent ~0.3 ms per frame in array
+    overhead for a handful of samples.
+    """
+    knots = np.empty(rel.size + 2)
+    rates = np.empty((rel.size + 2, 3))
+    knots[0], rates[0] = 0.0, _interp_rate(rel, ws, 0.0)
+    m = 1
+    for i in range(rel.size):
+        if 0.0 < rel[i] < t_end:
+            knots[m], rates[m] = rel[i], ws[i]
+            m += 1
+    knots[m], rates[m] = t_end, _interp_rate(rel, ws, t_end)
+    return magnus_product(knots[:m + 1], rates[:m + 1], coning)
+
+
+@numba.njit(cache=True)
+def _interp_rate(rel, ws, x):
+    j = 0
+    while j < rel.size - 2 and rel[j + 1] < x:
+        j += 1
+    if rel.size == 1:
+        return ws[0].copy()
+    f = min(max((x - rel[j]) / (rel[j + 1] - rel[j]), 0.0), 1.0)
+    return ws[j] + f * (ws[j + 1] - ws[j])

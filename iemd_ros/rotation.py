@@ -159,12 +159,25 @@ def integrate_rates(t, w, coning: bool = True) -> np.ndarray:
         raise ValueError(f"need t of shape (N,) and w of shape (N, 3), got {t.shape} and {w.shape}")
     if len(t) < 2:
         return np.array([1.0, 0.0, 0.0, 0.0])
-    h = np.diff(t)
-    if np.any(h <= 0):
+    if np.any(np.diff(t) <= 0):
         raise ValueError("knot times must be strictly increasing")
-    phi = 0.5 * h[:, None] * (w[:-1] + w[1:])
-    if coning:
-        phi = phi + (h ** 2 / 12.0)[:, None] * np.cross(w[:-1], w[1:])
+    return magnus_product(t, w, coning)
+
+
+@numba.njit(cache=True)
+def magnus_product(t, w, coning):
+    """The compiled core of :func:`integrate_rates` (knots already checked)."""
+    phi = np.empty((t.size - 1, 3))
+    for i in range(t.size - 1):
+        h = t[i + 1] - t[i]
+        a, b = w[i], w[i + 1]
+        for k in range(3):
+            phi[i, k] = 0.5 * h * (a[k] + b[k])
+        if coning:
+            c = h * h / 12.0
+            phi[i, 0] += c * (a[1] * b[2] - a[2] * b[1])
+            phi[i, 1] += c * (a[2] * b[0] - a[0] * b[2])
+            phi[i, 2] += c * (a[0] * b[1] - a[1] * b[0])
     return _exp_product(phi)
 
 
