@@ -13,7 +13,9 @@ is highly coherent, so first-order methods crawl); scikit-learn's
 ``sparse_encode(lasso_cd, positive=True)`` did not converge in 88 ms.
 SPAMS does not build here.  The active set (Lawson-Hanson on the quadratic
 program ``a'Ga - 2(b - lambda/2)'a``) terminates with the exact solution, so
-the KKT conditions hold to rounding, and it is fastest for sparse codes.
+the KKT conditions hold to rounding, and it is fastest for sparse codes.  With
+the residual updated row-wise in place it codes 49 patches in 0.4 ms against
+147 atoms (L = 3) and 0.1 ms against 49 atoms (L = 1, the default).
 
 lambda (the paper gives no value; the tracker's default is 0.1): with zero-mean
 unit patches and 3 templates (147 atoms), lambda = 0.01 gave 35 non-zeros per
