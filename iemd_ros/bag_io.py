@@ -10,25 +10,22 @@
   (:func:`iter_messages`).
 * :func:`select_topics`: the image / IMU / camera-info topics, auto-detected when a bag has exactly one
   topic of a type, else named (wrong type or ambiguity -> BagError).
-* :func:`cli_main`: the CLIs' error convention (one line on stderr, exit 2, no traceback).
 """
 from __future__ import annotations
 
 import shutil
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from .conversions import ns_to_stamp, stamp_to_ns
-from .evaluation import CliParser  # noqa: F401  (argparse errors -> UsageError, re-exported)
-from .evaluation import UsageError
+from .cli import one_line
 
 __all__ = ["IMAGE_TYPE", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE", "DIAGNOSTICS_TYPE", "FORMATS",
-           "BagError", "BagWriter", "CliParser", "Progress", "Topics", "UsageError", "camera_info_fields",
-           "cli_main", "custom_data", "deserialize", "header", "iter_messages", "open_bag", "resolve_bag_path",
+           "BagError", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize", "header", "iter_messages", "open_bag", "resolve_bag_path",
            "ros1_typestore", "ros2_typestore", "select_topics", "stamp_ns"]
 
 IMAGE_TYPE = "sensor_msgs/msg/Image"
@@ -197,13 +194,8 @@ def open_bag(path):
         reader = AnyReader([p], default_typestore=ros2_typestore())
         reader.open()
     except _reader_errors() as exc:
-        raise BagError(f"cannot read bag {p} (missing, truncated or corrupt?): {_one_line(exc)}") from None
+        raise BagError(f"cannot read bag {p} (missing, truncated or corrupt?): {one_line(exc)}") from None
     return reader
-
-
-def _one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return text if len(text) < 300 else text[:297] + "..."
 
 
 def iter_messages(reader, connections, path="bag") -> Iterator[tuple[object, int, bytes]]:
@@ -215,7 +207,7 @@ def iter_messages(reader, connections, path="bag") -> Iterator[tuple[object, int
         except StopIteration:
             return
         except _reader_errors() as exc:
-            raise BagError(f"bag {path} is truncated or corrupt: {_one_line(exc)}") from None
+            raise BagError(f"bag {path} is truncated or corrupt: {one_line(exc)}") from None
         yield item
 
 
@@ -223,7 +215,7 @@ def deserialize(reader, raw: bytes, msgtype: str, path="bag"):
     try:
         return reader.deserialize(raw, msgtype)
     except _reader_errors() as exc:
-        raise BagError(f"bag {path}: cannot decode a {msgtype} message: {_one_line(exc)}") from None
+        raise BagError(f"bag {path}: cannot decode a {msgtype} message: {one_line(exc)}") from None
 
 
 @dataclass(frozen=True)
@@ -272,19 +264,6 @@ def custom_data(reader) -> dict:
         md = getattr(getattr(r, "storage", None), "metadata", None)
         out.update(getattr(md, "custom", None) or {})
     return out
-
-
-# ---------------------------------------------------------------------------------------------- CLI
-def cli_main(prog: str, body: Callable[[], int]) -> int:
-    """Run ``body``; bad arguments / files (ValueError, OSError, usage errors) -> one stderr line, exit 2."""
-    try:
-        return body()
-    except (UsageError, ValueError, OSError) as exc:
-        print(f"{prog}: error: {_one_line(exc)}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
-        return 130
 
 
 class Progress:

@@ -47,9 +47,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from .bag_io import (CAMERA_INFO_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX, BagWriter,
-                     CliParser, camera_info_fields, cli_main, header)
+from .bag_io import CAMERA_INFO_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX, BagWriter, camera_info_fields, header
 from .camera import CameraModel
+from .cli import CliParser, cli_main
 from .otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
 from .recordings import seconds_to_ns, load_recording
 

@@ -24,7 +24,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .bag_io import BagError, CliParser, Progress, cli_main, iter_messages, open_bag, ros2_typestore
+from .bag_io import BagError, Progress, iter_messages, open_bag, ros2_typestore
+from .cli import CliParser, cli_main
 
 
 @dataclass

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .bag_io import CliParser, cli_main
+from .cli import CliParser, cli_main
 from .bag_make import source_from_synthetic, write_bag, write_gt
 from .metrics import OTB_THRESHOLDS, iou, score_sequence
 from .synthetic import SyntheticConfig, generate

@@ -36,6 +36,7 @@ from typing import Callable, Protocol
 import cv2
 import numpy as np
 
+from iemd_ros.cli import CliParser, cli_main
 from iemd_ros.metrics import OTB_THRESHOLDS, PRECISION_THRESHOLD, SequenceScores, score_sequence, valid_boxes
 from iemd_ros.otb import Sequence, default_root, is_sequence_folder, list_sequences, load_sequence
 
@@ -212,15 +213,6 @@ def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
     return "\n".join(lines)
 
 
-class CliParser(argparse.ArgumentParser):
-    def error(self, message: str):  # one readable line, exit 2 (no usage dump)
-        raise UsageError(message)
-
-
-class UsageError(Exception):
-    pass
-
-
 def _csv(text: str) -> list[str]:
     items = [t.strip() for t in text.split(",") if t.strip()]
     if not items:
@@ -345,7 +337,7 @@ def _json_default(obj):
 
 
 def main(argv: list[str] | None = None) -> int:
-    try:
+    def body() -> int:
         args = build_parser().parse_args(argv)
         trackers = list(dict.fromkeys(args.trackers))
         for t in trackers:
@@ -355,21 +347,15 @@ def main(argv: list[str] | None = None) -> int:
         sequences = collect_sequences(args.inputs, args.sequences)
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
-    except (UsageError, ValueError) as exc:
-        print(f"iemd-eval: error: {exc}", file=sys.stderr)
-        return 2
-    t_start = time.perf_counter()
-    print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) -> {args.out}")
-    try:
-        doc = evaluate(sequences, trackers, args.out)
-    except (ValueError, OSError) as exc:  # unreadable image, unwritable --out, ...
-        print(f"iemd-eval: error: {exc}", file=sys.stderr)
-        return 2
-    names = doc["sequences"]
-    print()
-    print(format_table(doc["results"], trackers, names))
-    print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}")
-    return 0
+        t_start = time.perf_counter()
+        print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) -> {args.out}")
+        doc = evaluate(sequences, trackers, args.out)  # unreadable image, unwritable --out: one line, exit 2
+        print()
+        print(format_table(doc["results"], trackers, doc["sequences"]))
+        print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}")
+        return 0
+
+    return cli_main("iemd-eval", body)
 
 
 if __name__ == "__main__":

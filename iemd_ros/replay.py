@@ -48,9 +48,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, CliParser, Progress, Topics,
-                     cli_main, deserialize, header, iter_messages, open_bag, select_topics, stamp_ns)
+from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Progress, Topics, deserialize, header,
+                     iter_messages, open_bag, select_topics, stamp_ns)
 from .camera import CameraModel
+from .cli import CliParser, cli_main
 from .conversions import box_to_bbox, camera_model_from_info, image_to_array
 from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
 
