@@ -35,10 +35,11 @@ SHM_PROFILE = ROOT / "config" / "fastdds_shm.xml"
 def _echo_main(reliable: bool) -> int:
     """--serve-echo: answer every image with an empty Detection2DArray (header copied)."""
     import rclpy
-    from rclpy.executors import ExternalShutdownException
     from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
     from sensor_msgs.msg import Image
     from vision_msgs.msg import Detection2DArray
+
+    from iemd_ros.node import spin_until_shutdown
 
     rclpy.init()
     node = rclpy.create_node("iemd_echo")
@@ -51,13 +52,7 @@ def _echo_main(reliable: bool) -> int:
 
     qos = QoSProfile(depth=5, reliability=QoSReliabilityPolicy.RELIABLE) if reliable else qos_profile_sensor_data
     node.create_subscription(Image, "image", on_image, qos)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    spin_until_shutdown(node)
     return 0
 
 

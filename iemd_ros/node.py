@@ -512,24 +512,31 @@ class TrackerNode(Node):
         return super().destroy_node()
 
 
-def main(args=None) -> int:
-    """Entry point of ``ros2 run iemd_ros tracker`` (and ``iemd-tracker``)."""
-    rclpy.init(args=args if args is not None else sys.argv)
-    node = None
-    code = 0
+def spin_until_shutdown(node) -> None:
+    """Spin ``node`` until Ctrl-C or an external shutdown, then destroy it and shut rclpy down."""
     try:
-        node = TrackerNode()
         rclpy.spin(node)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    finally:
+        node.destroy_node()
+        rclpy.try_shutdown()
+
+
+def main(args=None) -> int:
+    """Entry point of ``ros2 run iemd_ros tracker`` (and ``iemd-tracker``)."""
+    rclpy.init(args=args if args is not None else sys.argv)
+    try:
+        node = TrackerNode()
     except (ValueError, ParameterException) as exc:  # invalid parameters: one readable line, exit 2
         print(f"{NODE_NAME}: invalid parameters: {exc}", file=sys.stderr)
-        code = 2
-    finally:
-        if node is not None:
-            node.destroy_node()
         rclpy.try_shutdown()
-    return code
+        return 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        rclpy.try_shutdown()
+        return 0
+    spin_until_shutdown(node)
+    return 0
 
 
 if __name__ == "__main__":

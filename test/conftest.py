@@ -1,4 +1,6 @@
 """Shared fixtures: location of the real data in ../shared (skipped cleanly when absent)."""
+import signal
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -32,3 +34,24 @@ def ctx():
 
     with ros_context() as context:
         yield context
+
+
+@pytest.fixture
+def stop_process():
+    """``stop(proc, timeout=15)``: SIGINT a child (if still running), collect its output.
+
+    Returns ``(stdout, stderr, stopped)``; a child still running after ``timeout`` s is killed and
+    ``stopped`` is False.
+    """
+    def stop(proc: subprocess.Popen, timeout: float = 15.0):
+        if proc.poll() is None:
+            proc.send_signal(signal.SIGINT)
+        try:
+            out, err = proc.communicate(timeout=timeout)
+            return out, err, True
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            out, err = proc.communicate()
+            return out, err, False
+
+    return stop

@@ -2,7 +2,6 @@
 ament_index_python, then ``<prefix>/lib/iemd_ros/tracker``; run as its own process with the
 shipped params file, driven over DDS, stopped with SIGINT."""
 import os
-import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -68,7 +67,7 @@ def test_invalid_parameter_exits_2_with_one_line(executable):
     assert "invalid parameters: invalid tracker config: need 0 < min_step_px <= step_px" in proc.stderr
 
 
-def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable):
+def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable, stop_process):
     exe, params, env = executable
     seq = generate(n_frames=20, max_rate_deg_s=60.0, seed=5)
     s = [int(v) for v in seq.frame_stamps_ns]
@@ -108,13 +107,8 @@ def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable):
         finally:
             drv.node.destroy_node()
             rclpy.try_shutdown(context=context)
-            if proc.poll() is None:
-                proc.send_signal(signal.SIGINT)
-            try:
-                out, err = proc.communicate(timeout=15)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                out, err = proc.communicate()
+            out, err, stopped = stop_process(proc)
+            if not stopped:
                 pytest.fail(f"tracker did not stop within 15 s of SIGINT; stderr:\n{err}")
     assert proc.returncode == 0, err
     assert "Traceback" not in err + out, err

@@ -13,7 +13,6 @@ import importlib
 import importlib.util
 import json
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -196,8 +195,8 @@ def test_type_hashes_from_msg_text_with_rosidl(vm, tmp_path):
 def _publisher_main(topic: str) -> int:
     """Publish the sample Detection2DArray on ``topic`` at 20 Hz until SIGINT (or 60 s)."""
     import rclpy
-    from rclpy.executors import ExternalShutdownException
 
+    from iemd_ros.node import spin_until_shutdown
     from vision_msgs.msg import Detection2DArray
 
     rclpy.init()
@@ -215,13 +214,7 @@ def _publisher_main(topic: str) -> int:
             raise SystemExit(3)
 
     node.create_timer(0.05, tick)
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+    spin_until_shutdown(node)
     print(f"published {count}", flush=True)
     return 0
 
@@ -235,7 +228,7 @@ def _child_env(domain_id: int) -> dict:
     return env
 
 
-def test_detection2d_array_between_processes(vm, monkeypatch):
+def test_detection2d_array_between_processes(vm, monkeypatch, stop_process):
     import rclpy
     from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
@@ -263,13 +256,7 @@ def test_detection2d_array_between_processes(vm, monkeypatch):
         node.destroy_node()
     finally:
         rclpy.try_shutdown(context=context)
-        if publisher.poll() is None:
-            publisher.send_signal(signal.SIGINT)
-        try:
-            out, err = publisher.communicate(timeout=15)
-        except subprocess.TimeoutExpired:
-            publisher.kill()
-            out, err = publisher.communicate()
+        out, err, _ = stop_process(publisher)
     assert received, f"no Detection2DArray within 30 s; publisher stderr:\n{err[-2000:]}"
     assert received[0] == build_detection_array(rclpy_class)
     assert received[0].detections[0].bbox.size_y == 128.5
