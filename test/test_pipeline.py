@@ -29,6 +29,16 @@ def _feed_imu(p, seq, upto_ns=None):
             p.add_imu(int(t), w)
 
 
+def _started(seq):
+    """A pipeline with the camera and the whole gyro stream, initialised on frame 0; and the frame stamps."""
+    p = _pipeline(seq)
+    p.set_camera(seq.camera)
+    _feed_imu(p, seq)
+    stamps = [int(v) for v in seq.frame_stamps_ns]
+    p.init(seq.frames[0], seq.gt_boxes[0], stamps[0])
+    return p, stamps
+
+
 def _run(p, seq, frames=None):
     frames = seq.frames if frames is None else frames
     p.init(frames[0], seq.gt_boxes[0], int(seq.frame_stamps_ns[0]))
@@ -82,11 +92,7 @@ def test_no_camera_info_tracks_without_prior_and_warns(seq):
 
 
 def test_gyro_integrates_from_the_last_frame_that_was_not_lost(seq):
-    p = _pipeline(seq)
-    p.set_camera(seq.camera)
-    _feed_imu(p, seq)
-    stamps = [int(s) for s in seq.frame_stamps_ns]
-    p.init(seq.frames[0], seq.gt_boxes[0], stamps[0])
+    p, stamps = _started(seq)
     res = {k: p.process(seq.frames[k], stamps[k]) for k in range(1, 6)}
     noise = np.random.default_rng(0).integers(0, 256, seq.frames[6].shape, dtype=np.uint8)
     res[6] = p.process(noise, stamps[6])
@@ -131,11 +137,7 @@ def test_imu_validation_counts_and_explains(seq):
 
 
 def test_frame_stamps_going_back_are_rejected_or_reset(seq):
-    p = _pipeline(seq)
-    p.set_camera(seq.camera)
-    _feed_imu(p, seq)
-    s = [int(v) for v in seq.frame_stamps_ns]
-    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    p, s = _started(seq)
     assert p.process(seq.frames[2], s[2]).tracking
     r = p.process(seq.frames[1], s[1])
     assert r.rejected.startswith("image stamp went back by 33.3 ms") and r.box is None
@@ -177,11 +179,7 @@ def test_configure_validates_and_restarts_the_tracker(seq):
         PipelineConfig(imu_wait_ms=-1)
     cfg = PipelineConfig.from_dict({"gyro": {"time_offset_ns": 5, "R_cam_imu": np.eye(3).ravel().tolist()}})
     assert PipelineConfig.from_dict(cfg.to_dict()).to_dict() == cfg.to_dict()
-    p = _pipeline(seq)
-    p.set_camera(seq.camera)
-    _feed_imu(p, seq)
-    s = [int(v) for v in seq.frame_stamps_ns]
-    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    p, s = _started(seq)
     r1 = p.process(seq.frames[1], s[1])
     stored = p.diagnostics()["imu_stored"]
     new = PipelineConfig(tracker=TrackerConfig(n_particles=0), gyro=p.config.gyro)
