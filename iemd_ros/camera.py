@@ -45,6 +45,7 @@ class CameraModel:
         self.K = K
         self.K_inv = np.linalg.inv(K)
         self.D = np.concatenate([D, np.zeros(5 - len(D))])
+        self._has_distortion = bool(np.any(self.D != 0))
         if (width is None) != (height is None) or (width is not None and (int(width) <= 0 or int(height) <= 0)):
             raise ValueError(f"image size must be two positive integers, got {width}x{height}")
         self.width = None if width is None else int(width)
@@ -93,7 +94,7 @@ class CameraModel:
 
     @property
     def has_distortion(self) -> bool:
-        return bool(np.any(self.D != 0))
+        return self._has_distortion
 
     # ------------------------------------------------------------------ points
     @staticmethod
@@ -134,7 +135,7 @@ class CameraModel:
         xd, yd = self._to_norm(p)
         shape = np.shape(xd)
         x, y = _undistort_newton(np.ravel(xd).astype(np.float64), np.ravel(yd).astype(np.float64),
-                                 np.asarray(self.D, dtype=np.float64), iterations, tol)
+                                 self.D, iterations, tol)
         x, y = x.reshape(shape), y.reshape(shape)
         fx, fy = self._distort_norm(x, y)
         bad = ~(np.hypot(fx - xd, fy - yd) < 1e-9)

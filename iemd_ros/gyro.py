@@ -40,13 +40,16 @@ __all__ = ["rotation_homography", "warp_points", "box_centre", "box_grid", "loca
            "warp_difference", "GyroConfig", "GyroPrediction", "GyroPredictor"]
 
 
-def rotation_homography(K, R) -> np.ndarray:
-    """``K R^T K^-1``: undistorted pixels of frame k-1 -> frame k, for ``R`` = camera k in camera k-1."""
+def rotation_homography(K, R, K_inv=None) -> np.ndarray:
+    """``K R^T K^-1``: undistorted pixels of frame k-1 -> frame k, for ``R`` = camera k in camera k-1.
+
+    ``K_inv``: ``K^-1`` when the caller has it (``CameraModel.K_inv``), else it is computed.
+    """
     K = np.asarray(K, dtype=float)
     R = np.asarray(R, dtype=float)
     if K.shape != (3, 3) or R.shape != (3, 3):
         raise ValueError(f"K and R must be 3x3, got {K.shape} and {R.shape}")
-    H = K @ R.T @ np.linalg.inv(K)
+    H = K @ R.T @ (np.linalg.inv(K) if K_inv is None else K_inv)
     return H / H[2, 2]
 
 
@@ -96,10 +99,7 @@ def local_prior(box, H, camera: CameraModel | None = None) -> tuple[np.ndarray, 
     (``cv2.findHomography``, method 0) through the lens-aware images of :func:`box_grid`, then a
     translation so the box centre maps exactly.  Returns ``(prior, max_residual_px)`` over the grid.
     """
-    src = box_grid(box)
-    if camera is None or not camera.has_distortion:
-        return np.asarray(H, float) / H[2, 2], 0.0
-    return _fit_prior(box, src, _warp_grid(box, src, H, camera))
+    return _prior_and_box(box, H, camera)[:2]
 
 
 def predict_box(box, H, camera: CameraModel | None = None) -> np.ndarray:
@@ -108,7 +108,18 @@ def predict_box(box, H, camera: CameraModel | None = None) -> np.ndarray:
     The centre is the exact image of the box centre; the width/height are the mean lengths of the
     mapped top/bottom and left/right edges (so a camera roll moves but does not inflate the box).
     """
-    return _box_from_grid(warp_points(box_grid(box), H, camera))
+    return _prior_and_box(box, H, camera)[2]
+
+
+def _prior_and_box(box, H, camera):
+    """(local prior, its max residual px, predicted box): the lens-aware box grid is mapped once for both."""
+    src = box_grid(box)
+    dst = _warp_grid(box, src, H, camera)
+    if camera is not None and camera.has_distortion:
+        prior, res = _fit_prior(box, src, dst)
+    else:
+        prior, res = np.asarray(H, dtype=float) / H[2, 2], 0.0
+    return prior, res, _box_from_grid(dst)
 
 
 def _warp_grid(box, src, H, camera) -> np.ndarray:
@@ -271,18 +282,11 @@ class GyroPredictor:
         usable = integ.ok or (integ.status is Coverage.GAP and self.config.allow_gaps)
         if not usable:
             return GyroPrediction(integ, None, None, None, None, f"no gyro prior: {integ.reason}")
-        H = rotation_homography(self.camera.K, integ.R)
+        H = rotation_homography(self.camera.K, integ.R, self.camera.K_inv)
         if box is None:
             return GyroPrediction(integ, integ.R, H, H, None, integ.reason)
         try:
-            # The lens-aware grid is mapped once for both the prior and the predicted box.
-            src = box_grid(box)
-            dst = _warp_grid(box, src, H, self.camera)
-            if self.camera.has_distortion:
-                prior, res = _fit_prior(box, src, dst)
-            else:
-                prior, res = H / H[2, 2], 0.0
-            pbox = _box_from_grid(dst)
+            prior, res, pbox = _prior_and_box(box, H, self.camera)
         except ValueError as exc:       # box far outside the lens model's valid region
             return GyroPrediction(integ, integ.R, H, None, None, f"no gyro prior at this box: {exc}")
         return GyroPrediction(integ, integ.R, H, prior, pbox, integ.reason, res)

@@ -50,13 +50,17 @@ class ImuIntegration:
     """
 
     R: np.ndarray
-    q: np.ndarray
     n_samples: int
     status: Coverage
     reason: str
     t0_ns: int
     t1_ns: int
     max_gap_ns: int = 0
+
+    @property
+    def q(self) -> np.ndarray:
+        """``R`` as a unit quaternion (w, x, y, z), computed on demand (nothing on the frame path needs it)."""
+        return rot_to_quat(self.R)
 
     @property
     def covered(self) -> bool:
@@ -69,7 +73,7 @@ class ImuIntegration:
 
 
 def _identity(t0, t1, status, reason, n=0, gap=0) -> ImuIntegration:
-    return ImuIntegration(np.eye(3), np.array([1.0, 0.0, 0.0, 0.0]), n, status, reason, t0, t1, gap)
+    return ImuIntegration(np.eye(3), n, status, reason, t0, t1, gap)
 
 
 def _ms(ns) -> str:
@@ -245,18 +249,16 @@ class ImuBuffer:
         n_used = len(ts)
         max_gap = int(np.diff(ts).max()) if n_used > 1 else 0
         if t1 == t0:
-            return ImuIntegration(np.eye(3), np.array([1.0, 0.0, 0.0, 0.0]), n_used, Coverage.OK,
-                                  "empty window", t0, t1, max_gap)
+            return _identity(t0, t1, Coverage.OK, "empty window", n_used, max_gap)
         # knots: t0, the samples strictly inside, t1 (rates interpolated at the ends)
         q_imu = _window_rotation((ts - t0).astype(float) * 1e-9, np.ascontiguousarray(ws), (t1 - t0) * 1e-9,
                                  coning)
         R = cal.R_cam_imu @ quat_to_rot(q_imu) @ cal.R_cam_imu.T
-        q = rot_to_quat(R)
         if max_gap > self.max_gap_ns:
-            return ImuIntegration(R, q, n_used, Coverage.GAP,
+            return ImuIntegration(R, n_used, Coverage.GAP,
                                   f"gyro gap of {_ms(max_gap)} (> {_ms(self.max_gap_ns)}) inside the window; "
                                   "rate interpolated across it", t0, t1, max_gap)
-        return ImuIntegration(R, q, n_used, Coverage.OK, f"{n_used} gyro samples", t0, t1, max_gap)
+        return ImuIntegration(R, n_used, Coverage.OK, f"{n_used} gyro samples", t0, t1, max_gap)
 
     def stats(self) -> dict:
         """Counters (added, accepted, nan, saturated, duplicates, out_of_order, late, dropped) and size."""
