@@ -39,7 +39,7 @@ def _echo_main(reliable: bool) -> int:
     from sensor_msgs.msg import Image
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.node import spin_until_shutdown
+    from iemd_ros.spin import spin_until_shutdown
 
     rclpy.init()
     node = rclpy.create_node("iemd_echo")
@@ -65,7 +65,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     from sensor_msgs.msg import CameraInfo, Image, Imu
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.conversions import array_to_image_fields, ns_to_stamp, stamp_to_ns
+    from iemd_ros.conversions import array_to_image_fields, ns_to_stamp, stamp_ns
 
     env = dict(os.environ)             # the caller set FASTRTPS_DEFAULT_PROFILES_FILE for -shm
     box0 = [float(v) for v in seq.gt_boxes[0]]
@@ -113,7 +113,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
         def on_det(msg):
             t = time.perf_counter_ns()
             with lock:
-                got.setdefault(stamp_to_ns(msg.header.stamp.sec, msg.header.stamp.nanosec), t)
+                got.setdefault(stamp_ns(msg.header), t)
 
         def on_diag(msg):
             for st in msg.status:

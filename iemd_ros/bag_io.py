@@ -21,12 +21,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .conversions import ns_to_stamp, stamp_to_ns
+from .conversions import ns_to_stamp
 from .cli import one_line
 
 __all__ = ["IMAGE_TYPE", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE", "DIAGNOSTICS_TYPE", "FORMATS",
-           "BagError", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize", "header", "iter_messages", "open_bag", "resolve_bag_path",
-           "ros1_typestore", "ros2_typestore", "select_topics", "stamp_ns"]
+           "BagError", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize",
+           "header", "iter_messages", "open_bag", "resolve_bag_path", "ros1_typestore", "ros2_typestore",
+           "select_topics"]
 
 IMAGE_TYPE = "sensor_msgs/msg/Image"
 IMU_TYPE = "sensor_msgs/msg/Imu"
@@ -147,11 +148,6 @@ def camera_info_fields(ros1: bool, d, k, r, p) -> dict:
     """CameraInfo matrix fields under their ROS 1 (``D K R P``) or ROS 2 (``d k r p``) names."""
     names = ("D", "K", "R", "P") if ros1 else ("d", "k", "r", "p")
     return dict(zip(names, (np.asarray(v, dtype=np.float64).ravel() for v in (d, k, r, p))))
-
-
-def stamp_ns(header_msg) -> int:
-    """Nanoseconds of a rosbags ``Header`` (ROS 1 or 2)."""
-    return stamp_to_ns(header_msg.stamp.sec, header_msg.stamp.nanosec)
 
 
 # ---------------------------------------------------------------------------------------------- reading

@@ -42,10 +42,11 @@ from sensor_msgs.msg import CameraInfo, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithPose
 
-from .conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info, image_to_array,
-                          stamp_to_ns)
+from .conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_msg, image_to_array,
+                          stamp_ns)
 from .gyro import GyroConfig
 from .pipeline import ERROR, OK, WARN, PipelineConfig, TrackingPipeline, gyro_config_to_dict
+from .spin import spin_until_shutdown
 from .tracker import TrackerConfig
 
 __all__ = ["TrackerNode", "main", "NODE_NAME"]
@@ -264,14 +265,14 @@ class TrackerNode(Node):
             self._ring.append(msg)
             if self._latest is not None:
                 old = self._latest
-                self.pipeline.note_dropped(stamp_to_ns(old.header.stamp.sec, old.header.stamp.nanosec))
+                self.pipeline.note_dropped(stamp_ns(old.header))
             self._latest = msg
             self._latest_received = now
             self._cond.notify_all()
 
     def _on_imu(self, msg: Imu) -> None:
         self._last_imu_wall = time.monotonic()
-        t = stamp_to_ns(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        t = stamp_ns(msg.header)
         w = msg.angular_velocity
         if not self.pipeline.add_imu_message(t, (w.x, w.y, w.z), msg.angular_velocity_covariance[0]):
             self._warn(self.pipeline.last_reasons()["imu_reason"])
@@ -280,7 +281,7 @@ class TrackerNode(Node):
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
         try:
-            camera = camera_model_from_info(msg.k, msg.d, msg.distortion_model, msg.width, msg.height)
+            camera = camera_model_from_msg(msg)
         except ValueError as exc:
             self.pipeline.note_bad_camera_info(str(exc))
             self._warn(f"camera_info rejected: {exc}")
@@ -296,7 +297,7 @@ class TrackerNode(Node):
             self._note = f"~/init rejected: {exc}"
             self._warn(self._note)
             return
-        stamp = stamp_to_ns(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        stamp = stamp_ns(msg.header)
         with self._cond:
             self._ops.append(("init", box, stamp))
             self._pending_box = None
@@ -354,7 +355,7 @@ class TrackerNode(Node):
             self._note = "~/init ignored: no frame received yet"
             self._warn(self._note)
             return
-        stamps = np.array([stamp_to_ns(m.header.stamp.sec, m.header.stamp.nanosec) for m in frames])
+        stamps = np.array([stamp_ns(m.header) for m in frames])
         i = len(frames) - 1 if stamp == 0 else int(np.argmin(np.abs(stamps - stamp)))
         if stamp != 0 and abs(int(stamps[i]) - stamp) > self._init_tolerance_ns:
             self._note = (f"~/init ignored: no buffered frame within {self._init_tolerance_ns / 1e6:.0f} ms of its "
@@ -373,7 +374,7 @@ class TrackerNode(Node):
         self.get_logger().info(f"target initialized from ~/init at {box} on the frame stamped {int(stamps[i])} ns")
 
     def _handle_frame(self, msg: Image, received) -> None:
-        stamp = stamp_to_ns(msg.header.stamp.sec, msg.header.stamp.nanosec)
+        stamp = stamp_ns(msg.header)
         try:
             frame = image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, msg.is_bigendian)
         except ValueError as exc:
@@ -510,17 +511,6 @@ class TrackerNode(Node):
         if self._worker.is_alive() and threading.current_thread() is not self._worker:
             self._worker.join(timeout=5.0)
         return super().destroy_node()
-
-
-def spin_until_shutdown(node) -> None:
-    """Spin ``node`` until Ctrl-C or an external shutdown, then destroy it and shut rclpy down."""
-    try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
 
 
 def main(args=None) -> int:

@@ -5,7 +5,7 @@ The one place where per-message data flows into :class:`~iemd_ros.IemdTracker` a
 replay, so both produce the same boxes from the same messages:
 
     pipe = TrackingPipeline(PipelineConfig())
-    pipe.set_camera(camera)                      # from CameraInfo (conversions.camera_model_from_info)
+    pipe.set_camera(camera)                      # from CameraInfo (conversions.camera_model_from_msg)
     pipe.add_imu(t_ns, (wx, wy, wz))             # every Imu message (IMU frame, rad/s)
     pipe.init(frame, (x, y, w, h), t_ns)         # start (or restart) on a frame
     if pipe.gyro_ready(t_ns) or waited_long_enough:

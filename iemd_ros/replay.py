@@ -43,16 +43,15 @@ import sys
 import time
 from collections import deque
 from dataclasses import dataclass, field, fields, replace
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Progress, Topics, deserialize, header,
-                     iter_messages, open_bag, select_topics, stamp_ns)
+                     iter_messages, open_bag, select_topics)
 from .camera import CameraModel
 from .cli import CliParser, cli_main
-from .conversions import box_to_bbox, camera_model_from_info, image_to_array
+from .conversions import box_to_bbox, camera_model_from_msg, image_to_array, stamp_ns
 from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
 
 __all__ = ["ReplayResult", "replay", "parse_box", "load_gt", "write_csv", "CSV_HEADER", "main"]
@@ -274,20 +273,6 @@ class _Frame:
     error: str = ""
 
 
-def _camera_from_msg(msg) -> CameraModel:
-    k = getattr(msg, "k", None)
-    d = getattr(msg, "d", None)
-    if k is None:                                  # ROS 1 field names
-        k, d = msg.K, msg.D
-    return _camera_model(tuple(map(float, k)), tuple(map(float, d)), msg.distortion_model, msg.width, msg.height)
-
-
-@lru_cache(maxsize=4)
-def _camera_model(k: tuple, d: tuple, distortion_model: str, width: int, height: int) -> CameraModel:
-    """The model of one CameraInfo content, built once (a bag repeats it with every image: 0.2 ms each)."""
-    return camera_model_from_info(k, d, distortion_model, width, height)
-
-
 def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | None = None,
            camera_info_topic: str | None = None, config: PipelineConfig | None = None, use_gyro: bool = True,
            camera: CameraModel | None = None, csv_path=None, out_bag=None, video=None, progress: bool | None = None,
@@ -407,7 +392,7 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
                 pipe.add_imu_message(stamp_ns(msg.header), (av.x, av.y, av.z), msg.angular_velocity_covariance[0])
             else:
                 try:
-                    pipe.set_camera(_camera_from_msg(msg))
+                    pipe.set_camera(camera_model_from_msg(msg))
                 except ValueError as exc:
                     pipe.note_bad_camera_info(str(exc))
             flush(log_t, arrived=True)

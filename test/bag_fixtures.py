@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from iemd_ros.bag_io import open_bag, stamp_ns
+from iemd_ros.bag_io import open_bag
+from iemd_ros.conversions import stamp_ns
 from iemd_ros.bag_make import source_from_synthetic, write_bag
 from iemd_ros.synthetic import generate
 

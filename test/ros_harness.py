@@ -18,7 +18,7 @@ from sensor_msgs.msg import CameraInfo, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray
 
-from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp, stamp_to_ns
+from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp, stamp_ns  # noqa: F401  (stamp_ns: also for the tests)
 
 FRAME_ID = "synthetic_cam"
 
@@ -55,10 +55,6 @@ def ros_context():
 def level(status) -> int:
     lv = status.level
     return lv[0] if isinstance(lv, (bytes, bytearray)) else int(lv)
-
-
-def stamp_ns(header) -> int:
-    return stamp_to_ns(header.stamp.sec, header.stamp.nanosec)
 
 
 class Driver:

@@ -27,7 +27,7 @@ from vision_msgs.msg import Detection2DArray  # noqa: E402
 
 from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag  # noqa: E402
 from iemd_ros.bag_play import main, play  # noqa: E402
-from iemd_ros.conversions import bbox_to_box, stamp_to_ns  # noqa: E402
+from iemd_ros.conversions import bbox_to_box, stamp_ns  # noqa: E402
 from iemd_ros.pipeline import PipelineConfig  # noqa: E402
 from iemd_ros.replay import replay  # noqa: E402
 
@@ -42,10 +42,6 @@ def seq():
     return shaky_sequence(14)
 
 
-def _ns(header) -> int:
-    return stamp_to_ns(header.stamp.sec, header.stamp.nanosec)
-
-
 class Recorder:
     def __init__(self, context):
         self.node = rclpy.create_node("iemd_test_recorder", context=context)
@@ -53,9 +49,9 @@ class Recorder:
         self.got = {"img": [], "imu": [], "info": [], "det": []}
         q = QoSProfile(depth=1000, reliability=QoSReliabilityPolicy.RELIABLE)
         n = self.node
-        n.create_subscription(Image, IMG, lambda m: self._add("img", (time.monotonic(), _ns(m.header),
+        n.create_subscription(Image, IMG, lambda m: self._add("img", (time.monotonic(), stamp_ns(m.header),
                                                                      bytes(m.data), m.encoding)), q)
-        n.create_subscription(Imu, IMU, lambda m: self._add("imu", (_ns(m.header), m.angular_velocity.x)), q)
+        n.create_subscription(Imu, IMU, lambda m: self._add("imu", (stamp_ns(m.header), m.angular_velocity.x)), q)
         n.create_subscription(CameraInfo, INFO, lambda m: self._add("info", list(m.k)), q)
         n.create_subscription(Detection2DArray, "/detections", lambda m: self._add("det", m), q)
 
@@ -123,7 +119,7 @@ def _live_vs_offline(ctx, bag, init, n_frames):
         rec.node.destroy_node()
     assert stats.published[IMG] == n_frames
     assert done, f"the node answered {len(rec.got['det'])} of {n_frames} frames within 30 s"
-    return {_ns(m.header): m for m in rec.got["det"]}, counters
+    return {stamp_ns(m.header): m for m in rec.got["det"]}, counters
 
 
 def _compare(live: dict, offline, counters) -> tuple[int, int]:

@@ -196,7 +196,7 @@ def _publisher_main(topic: str) -> int:
     """Publish the sample Detection2DArray on ``topic`` at 20 Hz until SIGINT (or 60 s)."""
     import rclpy
 
-    from iemd_ros.node import spin_until_shutdown
+    from iemd_ros.spin import spin_until_shutdown
     from vision_msgs.msg import Detection2DArray
 
     rclpy.init()
