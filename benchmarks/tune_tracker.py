@@ -47,8 +47,8 @@ def discrimination(job, radius=40, grid=4):
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
         x, y, w, h = seq.gt_boxes[k]
         center, size = np.array([x + (w - 1) / 2, y + (h - 1) / 2]), np.array([w, h])
-        at_gt = tracker._evaluate(tracker._candidate(pyramid, center, size))[0]
-        others = [tracker._evaluate(tracker._candidate(pyramid, center + (dx, dy), size))[0]
+        at_gt = tracker._emd(tracker._candidate(pyramid, center, size))[0]
+        others = [tracker._emd(tracker._candidate(pyramid, center + (dx, dy), size))[0]
                   for dy in range(-radius, radius + 1, grid) for dx in range(-radius, radius + 1, grid)
                   if abs(dx) >= 0.3 * w or abs(dy) >= 0.3 * h]
         scores.append(100.0 * np.mean(np.array(others) < at_gt))

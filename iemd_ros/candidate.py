@@ -14,6 +14,8 @@ tests use to check the gradients against finite differences.
 """
 from __future__ import annotations
 
+from functools import cached_property
+
 import numba
 import numpy as np
 
@@ -37,22 +39,55 @@ class CandidateModel:
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
         self.alpha = alpha
-        template = pyramid.sample(self.center, self.size, layout.template_size, coarse, angle)
-        self.eps, jac = layout.extract_with_jacobian(template)
-        # d epsilon / d (window centre moved along its axes, image pixels): template pixels per image pixel.
-        self.eps_jacobian = jac * (np.asarray(layout.template_size, dtype=np.float64) / self.size)
+        self.layout = layout
+        self.template = pyramid.sample(self.center, self.size, layout.template_size, coarse, angle)
+        self.eps = layout.extract(self.template)
         self.pos = layout.positions()
         if coder is None:
             self.code_weights = np.ones(len(self.eps))
         else:
             self.code_weights = max_alignment_pooling(coder.encode(self.eps.T), n_templates)
         self.appearance_cost = alpha * appearance_distance(target_eps, self.eps)
+        self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
+
+    @cached_property
+    def patch_jacobian(self) -> np.ndarray:
+        """d epsilon / d(window shift along its axes), per template pixel, (N, d, 2).
+
+        Computed on first use: the descent needs it only where a step is accepted
+        (about 4 in 10 models; rejected trials and scale variants need only the EMD).
+        """
+        return self.layout.extract_with_jacobian(self.template)[1]
 
     def evaluate(self, y, bandwidth: float, target_pos, target_eps, target_weights, gradient: str):
         """EMD between the target and the kernel centred at offset ``y`` (normalized), and dEMD/dy.
 
         Returns (emd, gradient (2,) per normalized unit, EmdSolution or None when
-        no bin has weight).  ``gradient``:
+        no bin has weight): :meth:`emd` then :meth:`gradient`.
+        """
+        value, solution = self.emd(y, bandwidth, target_pos, target_weights)
+        if solution is None:
+            return value, np.zeros(2), None
+        return value, self.gradient(gradient, target_pos, target_eps), solution
+
+    def emd(self, y, bandwidth: float, target_pos, target_weights):
+        """(EMD, EmdSolution) between the target and the kernel centred at offset ``y``; (inf, None)
+        when no bin has weight.  The solution is kept for :meth:`gradient`."""
+        y = np.asarray(y, dtype=np.float64)
+        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, 1.0, bandwidth)
+        keep = np.flatnonzero(w_c > 0)
+        if keep.size == 0:
+            self._solved = None
+            return np.inf, None
+        cost = _transport_cost(self.appearance_cost, keep, np.asarray(target_pos, dtype=np.float64), self.pos, y,
+                               1.0 - self.alpha)
+        solution: EmdSolution = solve_emd(target_weights, w_c[keep], cost, check=False)
+        self._solved = (y, keep, dw_dy[keep], solution)
+        return solution.value, solution
+
+    def gradient(self, kind: str, target_pos, target_eps) -> np.ndarray:
+        """dEMD/dy (2,) per normalized unit at the last :meth:`emd`'s offset.  ``kind``:
+
         - "paper": eq. (10), the duals times dw_C/dy (patches fixed, kernel moves);
         - "envelope": the same model with the spatial ground distance moving too,
           sum_uv f_uv dd_uv/dy + sum_v v_v dw_C,v/dy;
@@ -63,29 +98,24 @@ class CandidateModel:
           . d eps_v/dy.  The pooled code weights also move with the content; that
           term is left out (they change slowly and have no closed-form derivative).
         """
-        y = np.asarray(y, dtype=np.float64)
-        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, 1.0, bandwidth)
-        keep = np.flatnonzero(w_c > 0)
-        if keep.size == 0:
-            return np.inf, np.zeros(2), None
-        cost = _transport_cost(self.appearance_cost, keep, np.asarray(target_pos, dtype=np.float64), self.pos, y,
-                               1.0 - self.alpha)
-        solution: EmdSolution = solve_emd(target_weights, w_c[keep], cost, check=False)
-        if gradient == "paper":
-            grad = emd_gradient(solution, dw_dy[keep])
-        elif gradient == "envelope":
+        if self._solved is None:
+            raise ValueError("gradient() needs a solved emd() first")
+        y, keep, dw_dy, solution = self._solved
+        if kind == "paper":
+            return emd_gradient(solution, dw_dy)
+        if kind == "envelope":
             diff = target_pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
-            grad = envelope_gradient(solution, dw_dy[keep], 2.0 * (1.0 - self.alpha) * diff)
-        elif gradient == "appearance":
+            return envelope_gradient(solution, dw_dy, 2.0 * (1.0 - self.alpha) * diff)
+        if kind == "appearance":
             if np.any(y != 0):
                 raise ValueError("the appearance gradient is defined at the model's own position (y = 0)")
             flow = solution.flow
-            grad_px = -2.0 * self.alpha * _appearance_contraction(flow.T @ target_eps, flow.sum(0), keep, self.eps,
-                                                                  self.eps_jacobian)
-            grad = grad_px * self.size / 2.0  # per normalized unit, like the other two
-        else:
-            raise ValueError(f"unknown gradient {gradient!r}")
-        return solution.value, grad, solution
+            # Per image pixel along the window's axes the Jacobian scales by T / size, and per
+            # normalized unit by size / 2: together -2 alpha (T / 2) sum r . d eps / d(template px).
+            contraction = _appearance_contraction(flow.T @ target_eps, flow.sum(0), keep, self.eps,
+                                                  self.patch_jacobian)
+            return -self.alpha * np.asarray(self.layout.template_size, dtype=np.float64) * contraction
+        raise ValueError(f"unknown gradient {kind!r}")
 
 
 @numba.njit(cache=True)

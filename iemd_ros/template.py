@@ -85,8 +85,6 @@ class TemplateDictionary:
         while an occluder is still replaced by what the dictionary predicts.
         """
         x = np.asarray(template, dtype=np.float64).ravel()
-        if not self.templates:
-            return x.reshape(template.shape)
         phi_t = np.column_stack([t.ravel() for t in self.templates])
         coder = SparseCoder(phi_t, self.reconstruction_lambda)
         half = 0.5 * self.reconstruction_lambda

@@ -201,6 +201,7 @@ class IemdTracker:
         pyramid = ImagePyramid(to_gray(frame))
 
         best = self._search(pyramid, center, size)
+        searches = [best]
         starts, codings = 1, best.codings
         baseline = self._background_emd
         if cfg.n_particles and (self._lost or best.emd > cfg.particle_trigger * baseline):
@@ -209,6 +210,7 @@ class IemdTracker:
             candidate = self._particle_search(pyramid, center + _particle_offsets(cfg.n_particles, distance) * size,
                                               size)
             starts, codings = starts + cfg.n_particles, codings + candidate.codings
+            searches.append(candidate)
             if candidate.emd < best.emd:
                 best = candidate
         scale, emd, scale_codings = self._search_scale(pyramid, best, size)
@@ -231,7 +233,7 @@ class IemdTracker:
                     self._refresh_target(None)
         return TrackResult(
             box=best_box, emd=emd, iterations=best.iterations, lost=lost, scale=scale, angle=angle, starts=starts,
-            codings=codings + scale_codings, solver_warnings=best.warnings,
+            codings=codings + scale_codings, solver_warnings=sum(s.warnings for s in searches),
             predicted_box=predicted, reason=reason,
         )
 
@@ -245,7 +247,7 @@ class IemdTracker:
         were easy, after which every frame counted as lost and, lost frames not
         updating it, it never recovered: 804 of 825 CMU desk frames.)
         """
-        values = [self._evaluate(self._candidate(pyramid, self._center + offset * self._size, self._size))[0]
+        values = [self._emd(self._candidate(pyramid, self._center + offset * self._size, self._size))[0]
                   for offset in _particle_offsets(4, 1.0)]
         finite = [v for v in values if np.isfinite(v)]
         return float(np.median(finite)) if finite else np.inf
@@ -273,9 +275,19 @@ class IemdTracker:
                               len(self.dictionary.templates), self._target.bins[1], self.config.alpha,
                               angle=self._search_angle)
 
+    def _emd(self, model: CandidateModel, coarse: bool = False):
+        """(EMD, EmdSolution) of ``model`` against the (coarse) target; the model keeps it for _gradient."""
+        pos, _, weights = (self._coarse_target if coarse else self._target).bins
+        return model.emd(np.zeros(2), self.config.kernel_bandwidth, pos, weights)
+
+    def _gradient(self, model: CandidateModel, coarse: bool = False) -> np.ndarray:
+        pos, eps, _ = (self._coarse_target if coarse else self._target).bins
+        return model.gradient(self.config.gradient, pos, eps)
+
     def _evaluate(self, model: CandidateModel, coarse: bool = False):
-        pos, eps, weights = (self._coarse_target if coarse else self._target).bins
-        return model.evaluate(np.zeros(2), self.config.kernel_bandwidth, pos, eps, weights, self.config.gradient)
+        """(EMD, its gradient, EmdSolution or None)."""
+        value, solution = self._emd(model, coarse)
+        return value, (np.zeros(2) if solution is None else self._gradient(model, coarse)), solution
 
     def _search(self, pyramid: ImagePyramid, center, size) -> _Descent:
         """Coarse-to-fine Algorithm 1 from one starting point.
@@ -288,9 +300,12 @@ class IemdTracker:
         (benchmarks/tune_tracker.py, Car4/Bolt2/Woman average overlap): on 36.2 %,
         off 34.9 % (it helps the panning Bolt2 and Woman, hurts the large Car4).
         """
-        if self.config.coarse_to_fine:
-            center = self._descend(pyramid, center, size, coarse=True).center
-        return self._descend(pyramid, center, size)
+        if not self.config.coarse_to_fine:
+            return self._descend(pyramid, center, size)
+        coarse = self._descend(pyramid, center, size, coarse=True)
+        fine = self._descend(pyramid, coarse.center, size)
+        fine.warnings += coarse.warnings
+        return fine
 
     def _particle_search(self, pyramid: ImagePyramid, starts: np.ndarray, size) -> _Descent:
         """Section 6.1's extra starting points, refined only where they look best.
@@ -300,30 +315,36 @@ class IemdTracker:
         descent.  Running the whole coarse-to-fine search from every start gave
         p95 update times of 80-100 ms (5x a normal frame).
         """
-        scored = []
+        scored, warnings = [], 0
         for start in starts:
             if self.config.coarse_to_fine:
-                start = self._descend(pyramid, start, size, coarse=True).center
-            scored.append((self._evaluate(self._candidate(pyramid, start, size))[0], start))
-        emd, start = min(scored, key=lambda item: item[0])
-        best = self._descend(pyramid, start, size)
-        best.codings += len(scored)
+                coarse = self._descend(pyramid, start, size, coarse=True)
+                start, warnings = coarse.center, warnings + coarse.warnings
+            model = self._candidate(pyramid, start, size)
+            emd, solution = self._emd(model)
+            warnings += int(solution is not None and not solution.optimal)
+            scored.append((emd, model))
+        best = self._descend(pyramid, None, size, start=min(scored, key=lambda item: item[0])[1])
+        best.codings += len(scored) - 1  # the winner's model is the descent's first
+        best.warnings += warnings
         return best
 
-    def _descend(self, pyramid: ImagePyramid, center, size, coarse: bool = False) -> _Descent:
+    def _descend(self, pyramid: ImagePyramid, center, size, coarse: bool = False,
+                 start: CandidateModel | None = None) -> _Descent:
         """Algorithm 1 from one start: move against dEMD/dy while the EMD decreases.
 
         The paper moves one pixel along the gradient and stops at the first EMD
         increase.  We start with ``step_px`` and halve the step on an increase,
         stopping below ``min_step_px``: the same stopping rule (the EMD no longer
         decreases, at the finest step), but it reaches sub-pixel positions and
-        covers larger motions in fewer EMD solves.
+        covers larger motions in fewer EMD solves.  ``start``: a model already
+        built at the starting window (then ``center`` is not used).
         """
         cfg = self.config
         half = np.asarray(size, dtype=np.float64) / 2.0
         c, s = np.cos(self._search_angle), np.sin(self._search_angle)
         axes = np.array([[c, -s], [s, c]])  # window axes -> image axes
-        model = self._candidate(pyramid, center, size, coarse)
+        model = start if start is not None else self._candidate(pyramid, center, size, coarse)
         emd, grad, sol = self._evaluate(model, coarse)
         state = _Descent(center=model.center, emd=emd,
                          warnings=int(sol is not None and not sol.optimal))
@@ -337,11 +358,11 @@ class IemdTracker:
                 break
             state.iterations += 1
             trial = self._candidate(pyramid, state.center - step * g_px / norm, size, coarse)
-            e_try, g_try, s_try = self._evaluate(trial, coarse)
+            e_try, s_try = self._emd(trial, coarse)
             state.codings += 1
             state.warnings += int(s_try is not None and not s_try.optimal)
-            if e_try < state.emd:
-                state.center, state.emd, grad = trial.center, e_try, g_try
+            if e_try < state.emd:  # the gradient is needed only where the step is accepted
+                state.center, state.emd, grad = trial.center, e_try, self._gradient(trial, coarse)
             else:
                 step *= 0.5
         return state
@@ -366,7 +387,7 @@ class IemdTracker:
         for direction in (-1.0, 1.0):
             for n in range(1, n_steps + 1):
                 scale = 1.0 + direction * n * cfg.scale_step
-                emd, _, sol = self._evaluate(self._candidate(pyramid, state.center, size * scale))
+                emd, sol = self._emd(self._candidate(pyramid, state.center, size * scale))
                 codings += 1
                 state.warnings += int(sol is not None and not sol.optimal)
                 if emd >= best_emd:
