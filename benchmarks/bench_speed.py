@@ -14,25 +14,24 @@ Sequences: a few OTB sequences (init on their first GT box) plus the 640x480 CMU
 """
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 
+from iemd_ros.cli import CliParser, cli_main
 from iemd_ros.evaluation import TRACKERS, make_tracker, run_tracker
 from iemd_ros.otb import default_root, list_sequences, load_sequence, read_frame
+from iemd_ros.recordings import load_recording
 
 DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
 
 
 def desk_sequence(n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
-    """First ``n`` CMU desk frames (640x480) and the 0-based first eagle-head GT box."""
-    paths = sorted((DESK / "desk_img").glob("*.jpg"))[:n]
-    first = (DESK / "gt_eagle_head.txt").read_text().splitlines()[0].split(",")[:4]
-    box = np.asarray([float(v) for v in first]) - np.array([1.0, 1.0, 0.0, 0.0])  # 1-based -> 0-based
-    return "desk-640x480", [read_frame(p) for p in paths], box
+    """First ``n`` CMU desk frames (640x480) and the first eagle-head GT box."""
+    rec = load_recording(DESK)
+    return "desk-640x480", [rec.load_frame(i) for i in range(min(n, len(rec)))], rec.gt_boxes[0]
 
 
 def otb_sequence(name: str, root: Path, n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
@@ -42,8 +41,11 @@ def otb_sequence(name: str, root: Path, n: int) -> tuple[str, list[np.ndarray], 
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.error = lambda msg: (print(f"bench_speed: error: {msg}", file=sys.stderr), sys.exit(2))  # one line
+    return cli_main("bench_speed", lambda: _main(argv))
+
+
+def _main(argv) -> int:
+    p = CliParser(prog="bench_speed", description=__doc__.split("\n\n")[0])
     p.add_argument("--trackers", default="iemd,csrt", help=f"comma-separated from {','.join(TRACKERS)}")
     p.add_argument("--reference", default="csrt", help="tracker the fps ratios are taken against")
     p.add_argument("--sequences", default="Car4,Bolt2,Woman,DragonBaby", help="OTB sequences")
@@ -53,26 +55,22 @@ def main(argv=None) -> int:
                    help="cv2.setNumThreads(N) before timing (default: OpenCV's own choice)")
     args = p.parse_args(argv)
     trackers = [t.strip() for t in args.trackers.split(",") if t.strip()]
-    try:
-        if args.frames < 2:
-            raise ValueError(f"--frames must be >= 2, got {args.frames}")
-        for t in trackers:
-            make_tracker(t)
-        if args.reference not in trackers:
-            raise ValueError(f"--reference {args.reference!r} is not among --trackers {trackers}")
-        root = default_root()
-        if root is None:
-            raise ValueError("../shared/data/otb not found")
-        names = [n for n in args.sequences.split(",") if n]
-        unknown = sorted(set(names) - set(list_sequences(root)))
-        if unknown:
-            raise ValueError(f"unknown OTB sequence(s) {', '.join(unknown)} in {root}")
-        loaders = [lambda n=n: otb_sequence(n, root, args.frames) for n in names]
-        if not args.no_desk and DESK.is_dir():
-            loaders.append(lambda: desk_sequence(args.frames))
-    except ValueError as exc:
-        print(f"bench_speed: error: {exc}", file=sys.stderr)
-        return 2
+    if args.frames < 2:
+        raise ValueError(f"--frames must be >= 2, got {args.frames}")
+    for t in trackers:
+        make_tracker(t)
+    if args.reference not in trackers:
+        raise ValueError(f"--reference {args.reference!r} is not among --trackers {trackers}")
+    root = default_root()
+    if root is None:
+        raise ValueError("../shared/data/otb not found")
+    names = [n for n in args.sequences.split(",") if n]
+    unknown = sorted(set(names) - set(list_sequences(root)))
+    if unknown:
+        raise ValueError(f"unknown OTB sequence(s) {', '.join(unknown)} in {root}")
+    loaders = [lambda n=n: otb_sequence(n, root, args.frames) for n in names]
+    if not args.no_desk and DESK.is_dir():
+        loaders.append(lambda: desk_sequence(args.frames))
 
     if args.cv_threads is not None:
         cv2.setNumThreads(args.cv_threads)

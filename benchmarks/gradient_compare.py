@@ -17,14 +17,10 @@ import numpy as np
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
+from iemd_ros.gyro import box_centre
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
 GRADIENTS = ("paper", "envelope", "appearance")
-
-
-def centre(box):
-    x, y, w, h = box
-    return np.array([x + (w - 1) / 2, y + (h - 1) / 2]), np.array([w, h], dtype=float)
 
 
 def main():
@@ -41,7 +37,7 @@ def main():
         for k in np.linspace(5, len(seq) - 1, 6).astype(int):
             prev, cur = read_frame(seq.frame_paths[k - 1]), read_frame(seq.frame_paths[k])
             pyramid = ImagePyramid(to_gray(cur))
-            truth, size = centre(seq.gt_boxes[k])
+            truth, size = box_centre(seq.gt_boxes[k]), np.asarray(seq.gt_boxes[k][2:], dtype=float)
             offsets = rng.uniform(-args.offset, args.offset, (args.starts, 2))
             for gradient in GRADIENTS:
                 tracker = IemdTracker(TrackerConfig(gradient=gradient))

@@ -32,17 +32,18 @@ ROOT = Path(__file__).resolve().parents[1]
 SHM_PROFILE = ROOT / "config" / "fastdds_shm.xml"
 
 
-def _echo_main(reliable: bool) -> int:
-    """--serve-echo: answer every image with an empty Detection2DArray (header copied)."""
-    import rclpy
+def _qos(reliable: bool):
+    """The image QoS of a run: reliable, or sensor-data (best effort) like a camera driver."""
     from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
+
+    return QoSProfile(depth=5, reliability=QoSReliabilityPolicy.RELIABLE) if reliable else qos_profile_sensor_data
+
+
+def _add_echo(node, reliable: bool) -> None:
+    """Make ``node`` answer every image with an empty Detection2DArray (header copied)."""
     from sensor_msgs.msg import Image
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.spin import spin_until_shutdown
-
-    rclpy.init()
-    node = rclpy.create_node("iemd_echo")
     pub = node.create_publisher(Detection2DArray, "detections", 10)
 
     def on_image(msg):
@@ -50,8 +51,18 @@ def _echo_main(reliable: bool) -> int:
         out.header = msg.header
         pub.publish(out)
 
-    qos = QoSProfile(depth=5, reliability=QoSReliabilityPolicy.RELIABLE) if reliable else qos_profile_sensor_data
-    node.create_subscription(Image, "image", on_image, qos)
+    node.create_subscription(Image, "image", on_image, _qos(reliable))
+
+
+def _echo_main(reliable: bool) -> int:
+    """--serve-echo: the echo as its own process."""
+    import rclpy
+
+    from iemd_ros.spin import spin_until_shutdown
+
+    rclpy.init()
+    node = rclpy.create_node("iemd_echo")
+    _add_echo(node, reliable)
     spin_until_shutdown(node)
     return 0
 
@@ -61,7 +72,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     from diagnostic_msgs.msg import DiagnosticArray
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.parameter import Parameter
-    from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
+    from rclpy.qos import QoSProfile
     from sensor_msgs.msg import CameraInfo, Image, Imu
     from vision_msgs.msg import Detection2DArray
 
@@ -82,13 +93,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
                     Parameter(k, value=v) for k, v in params.items()]))
             else:
                 echo = rclpy.create_node("iemd_echo", context=context)
-                epub = echo.create_publisher(Detection2DArray, "detections", 10)
-
-                def on_image(msg):
-                    out = Detection2DArray()
-                    out.header = msg.header
-                    epub.publish(out)
-                echo.create_subscription(Image, "image", on_image, qos_profile_sensor_data)
+                _add_echo(echo, args.reliable)
                 nodes.append(echo)
         else:
             if subject == "tracker":
@@ -100,8 +105,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
             proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
         drv = rclpy.create_node("iemd_latency_driver", context=context)
-        qos = QoSProfile(depth=5, reliability=QoSReliabilityPolicy.RELIABLE) if args.reliable else \
-            qos_profile_sensor_data
+        qos = _qos(args.reliable)
         img_pub = drv.create_publisher(Image, "image", qos)
         imu_pub = drv.create_publisher(Imu, "imu", QoSProfile(depth=200, reliability=qos.reliability))
         info_pub = drv.create_publisher(CameraInfo, "camera_info", qos)

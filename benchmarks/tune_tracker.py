@@ -22,6 +22,7 @@ import numpy as np
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.evaluation import IemdAdapter, run_tracker
+from iemd_ros.gyro import box_centre
 from iemd_ros.metrics import average_overlap, iou
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
@@ -45,12 +46,11 @@ def discrimination(job, radius=40, grid=4):
     scores = []
     for k in picks:
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
-        x, y, w, h = seq.gt_boxes[k]
-        center, size = np.array([x + (w - 1) / 2, y + (h - 1) / 2]), np.array([w, h])
+        center, size = box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
         at_gt = tracker._emd(tracker._candidate(pyramid, center, size))[0]
         others = [tracker._emd(tracker._candidate(pyramid, center + (dx, dy), size))[0]
                   for dy in range(-radius, radius + 1, grid) for dx in range(-radius, radius + 1, grid)
-                  if abs(dx) >= 0.3 * w or abs(dy) >= 0.3 * h]
+                  if abs(dx) >= 0.3 * size[0] or abs(dy) >= 0.3 * size[1]]
         scores.append(100.0 * np.mean(np.array(others) < at_gt))
     return scores
 

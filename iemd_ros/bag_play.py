@@ -71,13 +71,12 @@ def _parse_remaps(remaps) -> dict:
 
 def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s: float = 0.0,
          wait_subscribers_s: float = 0.0, clock: bool = False, qos_depth: int = 100, node=None,
-         progress: bool | None = False, should_stop=None, ros_args: list[str] | None = None) -> PlayStats:
+         progress: bool | None = False, ros_args: list[str] | None = None) -> PlayStats:
     """Publish ``bag`` with its timing scaled by ``1/rate``.
 
     ``topics``: only these bag topics (default all); ``remap``: bag topic -> published topic.
     ``node``: an rclpy node to create the publishers on (default: a new ``iemd_play`` node; rclpy is
     initialised if needed, with ``ros_args`` (``["--ros-args", ...]``), and shut down again).
-    ``should_stop()``: polled between messages.
     """
     import rclpy
     from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -103,7 +102,8 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
         if unknown:
             raise BagError(f"--remap of topic(s) not played: {', '.join(unknown)}")
         conns = [c for c in reader.connections if c.topic in wanted]
-        if not conns or sum(available[t].msgcount for t in wanted) == 0:
+        total = sum(available[t].msgcount for t in wanted)
+        if not conns or total == 0:
             raise BagError(f"bag {bag} has no message to play")
         classes = {c.msgtype: message_class(c.msgtype) for c in conns}
         if node is None:
@@ -130,14 +130,11 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
                 time.sleep(0.01)
         if delay_s > 0:
             time.sleep(delay_s)
-        total = sum(available[t].msgcount for t in wanted)
         bar = Progress(total, "iemd-play", progress)
         t0_log = t0_wall = None
         late_sum = 0.0
         n = 0
         for conn, log_t, raw in iter_messages(reader, conns, bag):
-            if should_stop is not None and should_stop():
-                break
             msg = deserialize_message(convert[conn.msgtype](raw), classes[conn.msgtype])
             if t0_log is None:
                 t0_log, t0_wall = log_t, time.monotonic()
@@ -146,8 +143,6 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
                 time.sleep(min(wait, 0.05))
             late = (time.monotonic() - target) * 1e3
             if clock_pub is not None:
-                from rosgraph_msgs.msg import Clock
-
                 cm = Clock()
                 cm.clock.sec, cm.clock.nanosec = divmod(int(log_t), 1_000_000_000)
                 clock_pub.publish(cm)

@@ -74,7 +74,6 @@ class ReplayResult:
     bag: str
     topics: Topics
     results: list[FrameResult]
-    log_times_ns: list[int]
     wall_s: float                     # whole replay (reading, decoding, tracking, writing)
     track_s: float                    # sum of the tracker's processing_ms (updates)
     warnings: list[str] = field(default_factory=list)
@@ -317,7 +316,6 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
         wait_ns = int(round(cfg.imu_wait_ms * 1e6))
         bar = Progress(n_images, "iemd-replay", progress)
         results: list[FrameResult] = []
-        log_times: list[int] = []
         pending: deque[_Frame] = deque()
         out = _OutBag(out_bag, topics.image) if out_bag is not None else None
         if out is not None:
@@ -332,7 +330,6 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
         def emit(f: _Frame, r: FrameResult) -> None:
             nonlocal vid
             results.append(r)
-            log_times.append(f.log_t)
             if out is not None:
                 out.write(f.log_t, f.frame_id, r, pipe.statuses(), r.reason == INIT_REASON or r.tracking)
             if video is not None and f.image is not None:
@@ -409,7 +406,7 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
         for o in outputs:
             o.close()
         outputs.clear()
-        return ReplayResult(str(bag), topics, results, log_times, wall,
+        return ReplayResult(str(bag), topics, results, wall,
                             sum(r.processing_ms for r in results) / 1e3, warnings, pipe.diagnostics(), dropped,
                             init_s[0])
     except BaseException as exc:
