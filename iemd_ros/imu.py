@@ -171,18 +171,22 @@ class ImuBuffer:
         """Fold pending samples into the sorted store; merge equal stamps; enforce the memory bound."""
         if not self._n_pend:
             return
-        t = np.concatenate([self._t, *self._pend_t])
-        w = np.concatenate([self._w, *self._pend_w])
-        n = np.concatenate([self._n, np.ones(self._n_pend)])
+        pt = np.concatenate(self._pend_t)
+        pw = np.concatenate(self._pend_w)
         self._pend_t, self._pend_w, self._n_pend = [], [], 0
-        order = np.argsort(t, kind="stable")
-        t, w, n = t[order], w[order], n[order]
-        tu, start = np.unique(t, return_index=True)
-        if len(tu) < len(t):
-            self.counts["duplicates"] += len(t) - len(tu)
+        order = np.argsort(pt, kind="stable")
+        pt, pw = pt[order], pw[order]
+        t, w = np.concatenate([self._t, pt]), np.concatenate([self._w, pw])
+        n = np.concatenate([self._n, np.ones(len(pt))])
+        if len(self._t) and pt[0] <= self._t[-1]:   # reaching back into the store: sort it all again
+            order = np.argsort(t, kind="stable")     # (usually all pending samples are newer: appended)
+            t, w, n = t[order], w[order], n[order]
+        start = np.flatnonzero(np.concatenate([[True], t[1:] != t[:-1]]))  # first of each stamp (t sorted)
+        if len(start) < len(t):
+            self.counts["duplicates"] += len(t) - len(start)
             nn = np.add.reduceat(n, start)
             w = np.add.reduceat(w * n[:, None], start, axis=0) / nn[:, None]
-            t, n = tu, nn
+            t, n = t[start], nn
         keep_from = max(len(t) - self.max_samples, int(np.searchsorted(t, t[-1] - self.max_duration_ns)))
         self.counts["dropped"] += keep_from
         self._t, self._w, self._n = t[keep_from:], w[keep_from:], n[keep_from:]

@@ -21,6 +21,7 @@ outline (through the lens) in the tracker's convention (the box covers pixels x 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import cv2
 import numpy as np
@@ -96,7 +97,7 @@ class SyntheticSequence:
     visible: np.ndarray           # (N,) target outline fully inside the image and in front
     config: SyntheticConfig
 
-    @property
+    @cached_property
     def camera(self) -> CameraModel:
         return CameraModel(self.K, self.dist, self.config.width, self.config.height, "synthetic")
 

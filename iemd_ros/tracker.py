@@ -191,11 +191,11 @@ class IemdTracker:
             raise RuntimeError("IemdTracker.update() called before init()")
         _check_frame(frame)
         cfg = self.config
-        self._frame_index += 1
         center, size, angle = self._center.copy(), self._size.copy(), self._angle
-        if prior is not None:
+        if prior is not None:  # may raise ValueError: before any state changes, so a retry sees none
             center, size, turn = _apply_prior(_check_prior(prior), center, size)
             angle = _wrap_angle(angle + turn)
+        self._frame_index += 1
         self._search_angle = angle
         predicted = _box(center, size, angle)
         pyramid = ImagePyramid(to_gray(frame))
