@@ -21,41 +21,19 @@ from pathlib import Path
 
 import numpy as np
 
-from iemd_ros.gyro import GyroConfig, GyroPredictor
 from iemd_ros.metrics import score_sequence
-from iemd_ros.recordings import load_recording
+from iemd_ros.recordings import load_recording, track_recording
 
 DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu"
 
 
 def run(rec, start: int, stop: int, use_gyro: bool, scale_range: float):
-    """Tracker boxes for frames start..stop-1 (the init frame gets its GT box), and prior notes."""
-    from iemd_ros import IemdTracker, TrackerConfig
+    """Tracker boxes for frames start..stop-1 (the init frame gets its GT box), lost count, prior notes."""
+    from iemd_ros import TrackerConfig
 
-    tracker = IemdTracker(TrackerConfig(scale_range=scale_range))
-    tracker.init(rec.load_frame(start), rec.gt_boxes[start])
-    pred = None
-    if use_gyro:
-        pred = GyroPredictor(rec.camera, GyroConfig(time_offset_ns=rec.time_offset_ns, buffer_ns=10 ** 13,
-                                                    buffer_samples=10 ** 7))
-        pred.add_imu(rec.imu_t_ns, rec.gyro)
-    boxes = [np.asarray(rec.gt_boxes[start], float)]
-    anchor, anchor_box = start, np.asarray(rec.gt_boxes[start], float)   # frame + box of the tracker's window
-    n_lost, no_prior = 0, []
-    for k in range(start + 1, stop):
-        prior = None
-        if pred is not None:
-            p = pred.predict(rec.frame_stamps_ns[anchor], rec.frame_stamps_ns[k], anchor_box)
-            prior = p.prior
-            if prior is None:
-                no_prior.append(f"frame {k}: {p.reason}")
-        res = tracker.update(rec.load_frame(k), prior=prior)
-        boxes.append(np.asarray(res.box, float))
-        if res.lost:
-            n_lost += 1
-        else:
-            anchor, anchor_box = k, np.asarray(res.box, float)
-    return np.array(boxes), n_lost, no_prior
+    results, no_prior = track_recording(rec, start, stop, use_gyro, TrackerConfig(scale_range=scale_range))
+    boxes = [np.asarray(rec.gt_boxes[start], float)] + [np.asarray(r.box, float) for r in results]
+    return np.array(boxes), sum(r.lost for r in results), no_prior
 
 
 def main(argv=None) -> int:

@@ -13,8 +13,9 @@ at the window's circumscribed circle and weight every patch.  Measured
 overlap, L = 1): h = 1.0: 31.9 %; 1.2: 31.2 %; 1.414: 34.7 %; sqrt(2): 28.2 %;
 1.7: 27.1 %.  1.414 and sqrt(2) differ by 6.5 points through single sequences
 (Bolt2 50.6 vs 8.2 %): no value is reliably better, and h = 1 solves smaller
-EMDs.  ``s`` is the candidate's relative scale (the scale search
-enlarges/shrinks the window).
+EMDs.  ``s`` scales the kernel relative to the sampled window; the tracker
+passes 1, because its scale search resamples the window instead
+(IemdTracker._search_scale says why).
 """
 from __future__ import annotations
 

@@ -23,8 +23,11 @@ import cv2
 import numpy as np
 
 from .camera import CameraModel
+from .gyro import GyroConfig, GyroPredictor
+from .tracker import IemdTracker, TrackerConfig, TrackResult
 
-__all__ = ["Recording", "load_recording", "load_cmu", "load_phone", "load_gt_boxes", "CMU_TIME_OFFSET_NS"]
+__all__ = ["Recording", "load_recording", "load_cmu", "load_phone", "load_gt_boxes", "track_recording",
+           "CMU_TIME_OFFSET_NS"]
 
 #: The authors' ``Time_offset -20`` (ms): ``t_imu = t_file - 20 ms``.
 CMU_TIME_OFFSET_NS = -20_000_000
@@ -175,3 +178,35 @@ def load_recording(path) -> Recording:
     if (root / "derived_gyro_camframe.csv").exists():
         return load_phone(root)
     raise ValueError(f"{root}: neither a CMU recording (*_img.log) nor the phone one (derived_gyro_camframe.csv)")
+
+
+def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True,
+                    config: TrackerConfig | None = None) -> tuple[list[TrackResult], list[str]]:
+    """Track frames ``start+1 .. stop-1`` of ``rec`` from its GT box at ``start``, causally.
+
+    With ``use_gyro`` the prior for frame k is the lens-aware local homography at the tracker's
+    window, integrated from the frame that window belongs to (after a frame reported lost the
+    tracker keeps its previous window, so the rotation is integrated from that frame), as the node
+    does.  Returns the results and one note per frame that got no gyro prior.
+    """
+    tracker = IemdTracker(config)
+    tracker.init(rec.load_frame(start), rec.gt_boxes[start])
+    pred = None
+    if use_gyro:
+        pred = GyroPredictor(rec.camera, GyroConfig(time_offset_ns=rec.time_offset_ns, buffer_ns=10 ** 13,
+                                                    buffer_samples=10 ** 7))
+        pred.add_imu(rec.imu_t_ns, rec.gyro)
+    anchor, anchor_box = start, np.asarray(rec.gt_boxes[start], float)   # frame + box of the tracker's window
+    results, no_prior = [], []
+    for k in range(start + 1, stop):
+        prior = None
+        if pred is not None:
+            p = pred.predict(rec.frame_stamps_ns[anchor], rec.frame_stamps_ns[k], anchor_box)
+            prior = p.prior
+            if prior is None:
+                no_prior.append(f"frame {k}: {p.reason}")
+        res = tracker.update(rec.load_frame(k), prior=prior)
+        results.append(res)
+        if not res.lost:
+            anchor, anchor_box = k, np.asarray(res.box, float)
+    return results, no_prior
