@@ -23,9 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .bag_make import source_from_synthetic, write_bag
 from .cli import CliParser, cli_main
-from .bag_make import source_from_synthetic, write_bag, write_gt
-from .metrics import OTB_THRESHOLDS, iou, score_sequence
+from .metrics import OTB_THRESHOLDS, iou
 from .synthetic import SyntheticConfig, generate
 
 DEFAULT_OUT = Path("out") / "demo"
@@ -44,7 +44,7 @@ def run_demo(out: Path = DEFAULT_OUT, n_frames: int = 90, seed: int = 1, max_rat
              progress: bool | None = None, log=print) -> dict:
     """Generate, write, replay twice, score, plot.  Returns ``{mode: (ReplayResult, SequenceScores)}``
     plus the paths under ``"paths"``."""
-    from .replay import replay
+    from .replay import replay, score_replay
 
     if n_frames < 2:
         raise ValueError(f"--frames must be >= 2, got {n_frames}")
@@ -57,25 +57,21 @@ def run_demo(out: Path = DEFAULT_OUT, n_frames: int = 90, seed: int = 1, max_rat
     out.mkdir(parents=True, exist_ok=True)
     t0 = time.perf_counter()
     seq = generate(demo_config(n_frames, seed, max_rate_deg_s))
-    info = write_bag(source_from_synthetic(seq), bag, "mcap")
     gt_path = out / "ground_truth.txt"
-    write_gt(gt_path, seq.gt_boxes)
+    info = write_bag(source_from_synthetic(seq), bag, "mcap", gt_out=gt_path)
     log(f"iemd-demo: wrote {bag} ({info['frames']} frames {info['size'][0]}x{info['size'][1]}, {info['imu']} gyro "
         f"samples, peak {max_rate_deg_s:g} deg/s shake) in {time.perf_counter() - t0:.1f} s")
     init = tuple(float(v) for v in seq.gt_boxes[0])
     runs = {}
+    csv_paths = {label: out / f"replay_{label.replace('-', '_')}.csv" for label, _ in MODES}
     for label, use in MODES:
-        csv_path = out / f"replay_{label.replace('-', '_')}.csv"
-        res = replay(bag, init, use_gyro=use, csv_path=csv_path, progress=progress)
-        fps = len(res.results) / res.track_s if res.track_s > 0 else float("inf")
-        scores = score_sequence(res.boxes, seq.gt_boxes, label, fps=fps)
-        runs[label] = (res, scores)
+        res = replay(bag, init, use_gyro=use, csv_path=csv_paths[label], progress=progress)
+        runs[label] = (res, score_replay(res, seq.gt_boxes, label))
         log(f"iemd-demo: replay {label:<7}: {len(res.results)} frames, gyro prior on {res.gyro_used}, "
-            f"{res.wall_s:.1f} s -> {csv_path}")
+            f"{res.wall_s:.1f} s -> {csv_paths[label]}")
     plot = out / "demo.png"
     plot_demo(runs, seq.gt_boxes, plot)
-    runs["paths"] = dict(bag=bag, ground_truth=gt_path, plot=plot,
-                         csv={label: out / f"replay_{label.replace('-', '_')}.csv" for label, _ in MODES})
+    runs["paths"] = dict(bag=bag, ground_truth=gt_path, plot=plot, csv=csv_paths)
     return runs
 
 

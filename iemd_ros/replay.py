@@ -422,16 +422,23 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
 
 
 # ---------------------------------------------------------------------------------------------- CLI
-def evaluation_table(result: ReplayResult, gt: np.ndarray, name: str, label: str = "iemd") -> tuple[str, object]:
-    """Scores of the replay against ``gt`` and the table of :func:`iemd_ros.evaluation.format_table`."""
-    from .evaluation import MEAN, format_table, mean_scores
+def score_replay(result: ReplayResult, gt: np.ndarray, name: str):
+    """The tracker evaluation's scores (:class:`iemd_ros.metrics.SequenceScores`) of a replay against ``gt``;
+    fps counts the tracker's processing time only."""
     from .metrics import score_sequence
 
     boxes = result.boxes
     if len(gt) != len(boxes):
         raise ValueError(f"the ground truth has {len(gt)} boxes for {len(boxes)} images in the bag")
     fps = len(boxes) / result.track_s if result.track_s > 0 else math.inf
-    scores = score_sequence(boxes, gt, name, fps=fps)
+    return score_sequence(boxes, gt, name, fps=fps)
+
+
+def evaluation_table(result: ReplayResult, gt: np.ndarray, name: str, label: str = "iemd") -> tuple[str, object]:
+    """Scores of the replay against ``gt`` and the table of :func:`iemd_ros.evaluation.format_table`."""
+    from .evaluation import MEAN, format_table, mean_scores
+
+    scores = score_replay(result, gt, name)
     table = format_table({label: {name: scores.to_dict(), MEAN: mean_scores([scores])}}, [label], [name])
     return table, scores
 
