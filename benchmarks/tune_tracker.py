@@ -47,8 +47,8 @@ def discrimination(job, radius=40, grid=4):
     for k in picks:
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
         center, size = box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
-        at_gt = tracker._emd(tracker._candidate(pyramid, center, size))[0]
-        others = [tracker._emd(tracker._candidate(pyramid, center + (dx, dy), size))[0]
+        at_gt = tracker._candidate(pyramid, center, size).emd()[0]
+        others = [tracker._candidate(pyramid, center + (dx, dy), size).emd()[0]
                   for dy in range(-radius, radius + 1, grid) for dx in range(-radius, radius + 1, grid)
                   if abs(dx) >= 0.3 * size[0] or abs(dy) >= 0.3 * size[1]]
         scores.append(100.0 * np.mean(np.array(others) < at_gt))

@@ -14,6 +14,7 @@ tests use to check the gradients against finite differences.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import cached_property
 
 import numba
@@ -21,15 +22,38 @@ import numpy as np
 
 from .appearance import ImagePyramid, PatchLayout
 from .emd import EmdSolution, appearance_distance, emd_gradient, envelope_gradient, solve_emd
-from .histogram import candidate_weights
+from .histogram import candidate_weights, target_weights
 from .sparse_coding import SparseCoder, max_alignment_pooling
 
 
-class CandidateModel:
-    """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``."""
+@dataclass(frozen=True)
+class TargetModel:
+    """The target histogram of eq. (sparse target model): the bins that carry mass.
 
-    def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, coder: SparseCoder | None,
-                 n_templates: int, target_eps: np.ndarray, alpha: float, coarse: int = 0,
+    ``pos`` (N_T, 2) normalized patch centres, ``eps`` (N_T, d) appearance
+    vectors, ``weights`` w_T summing to 1.  Bins outside the kernel (the
+    window's corners) are dropped: they change neither the optimal flow nor
+    the candidate duals, and dropping them once saves the solver's filtering
+    on every solve.
+    """
+
+    pos: np.ndarray
+    eps: np.ndarray
+    weights: np.ndarray
+
+    @classmethod
+    def from_patches(cls, pos, eps, code_weights, bandwidth: float) -> "TargetModel":
+        weights = target_weights(code_weights, pos, bandwidth)
+        keep = np.flatnonzero(weights > 0)
+        return cls(pos=np.asarray(pos, dtype=np.float64)[keep], eps=np.asarray(eps, dtype=np.float64)[keep],
+                   weights=weights[keep])
+
+
+class CandidateModel:
+    """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``, against ``target``."""
+
+    def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, target: TargetModel,
+                 coder: SparseCoder | None, n_templates: int, alpha: float, bandwidth: float, coarse: int = 0,
                  angle: float = 0.0):
         """``coder=None`` (the coarse stage) gives every patch code weight 1: only the kernel weights bins.
 
@@ -38,7 +62,9 @@ class CandidateModel:
         """
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
+        self.target = target
         self.alpha = alpha
+        self.bandwidth = bandwidth
         self.layout = layout
         self.template = pyramid.sample(self.center, self.size, layout.template_size, coarse, angle)
         self.eps = layout.extract(self.template)
@@ -47,7 +73,7 @@ class CandidateModel:
             self.code_weights = np.ones(len(self.eps))
         else:
             self.code_weights = max_alignment_pooling(coder.encode(self.eps.T), n_templates)
-        self.appearance_cost = alpha * appearance_distance(target_eps, self.eps)
+        self.appearance_cost = alpha * appearance_distance(target.eps, self.eps)
         self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
 
     @cached_property
@@ -59,33 +85,32 @@ class CandidateModel:
         """
         return self.layout.extract_with_jacobian(self.template)[1]
 
-    def evaluate(self, y, bandwidth: float, target_pos, target_eps, target_weights, gradient: str):
+    def evaluate(self, gradient: str, y=(0.0, 0.0)):
         """EMD between the target and the kernel centred at offset ``y`` (normalized), and dEMD/dy.
 
         Returns (emd, gradient (2,) per normalized unit, EmdSolution or None when
         no bin has weight): :meth:`emd` then :meth:`gradient`.
         """
-        value, solution = self.emd(y, bandwidth, target_pos, target_weights)
+        value, solution = self.emd(y)
         if solution is None:
             return value, np.zeros(2), None
-        return value, self.gradient(gradient, target_pos, target_eps), solution
+        return value, self.gradient(gradient), solution
 
-    def emd(self, y, bandwidth: float, target_pos, target_weights):
+    def emd(self, y=(0.0, 0.0)):
         """(EMD, EmdSolution) between the target and the kernel centred at offset ``y``; (inf, None)
         when no bin has weight.  The solution is kept for :meth:`gradient`."""
         y = np.asarray(y, dtype=np.float64)
-        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, 1.0, bandwidth)
+        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, self.bandwidth)
         keep = np.flatnonzero(w_c > 0)
         if keep.size == 0:
             self._solved = None
             return np.inf, None
-        cost = _transport_cost(self.appearance_cost, keep, np.asarray(target_pos, dtype=np.float64), self.pos, y,
-                               1.0 - self.alpha)
-        solution: EmdSolution = solve_emd(target_weights, w_c[keep], cost, check=False)
+        cost = _transport_cost(self.appearance_cost, keep, self.target.pos, self.pos, y, 1.0 - self.alpha)
+        solution: EmdSolution = solve_emd(self.target.weights, w_c[keep], cost, check=False)
         self._solved = (y, keep, dw_dy[keep], solution)
         return solution.value, solution
 
-    def gradient(self, kind: str, target_pos, target_eps) -> np.ndarray:
+    def gradient(self, kind: str) -> np.ndarray:
         """dEMD/dy (2,) per normalized unit at the last :meth:`emd`'s offset.  ``kind``:
 
         - "paper": eq. (10), the duals times dw_C/dy (patches fixed, kernel moves);
@@ -104,7 +129,7 @@ class CandidateModel:
         if kind == "paper":
             return emd_gradient(solution, dw_dy)
         if kind == "envelope":
-            diff = target_pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
+            diff = self.target.pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
             return envelope_gradient(solution, dw_dy, 2.0 * (1.0 - self.alpha) * diff)
         if kind == "appearance":
             if np.any(y != 0):
@@ -112,7 +137,7 @@ class CandidateModel:
             flow = solution.flow
             # Per image pixel along the window's axes the Jacobian scales by T / size, and per
             # normalized unit by size / 2: together -2 alpha (T / 2) sum r . d eps / d(template px).
-            contraction = _appearance_contraction(flow.T @ target_eps, flow.sum(0), keep, self.eps,
+            contraction = _appearance_contraction(flow.T @ self.target.eps, flow.sum(0), keep, self.eps,
                                                   self.patch_jacobian)
             return -self.alpha * np.asarray(self.layout.template_size, dtype=np.float64) * contraction
         raise ValueError(f"unknown gradient {kind!r}")

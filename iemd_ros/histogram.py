@@ -2,7 +2,7 @@
 
 Bin r carries the pooled code weight ``p_r`` (or ``q_r``) of patch r and the
 Epanechnikov profile ``k(x) = max(0, 1 - x)`` of its squared normalized distance
-to the window centre, ``x = ||(c_r - y) / (s h)||^2``.
+to the window centre, ``x = ||(c_r - y) / h||^2``.
 
 Bandwidth choice (the paper only says "h is template size"): positions are in
 normalized window units (the window is [-1, 1]^2).  The tracker's default is
@@ -13,9 +13,8 @@ at the window's circumscribed circle and weight every patch.  Measured
 overlap, L = 1): h = 1.0: 31.9 %; 1.2: 31.2 %; 1.414: 34.7 %; sqrt(2): 28.2 %;
 1.7: 27.1 %.  1.414 and sqrt(2) differ by 6.5 points through single sequences
 (Bolt2 50.6 vs 8.2 %): no value is reliably better, and h = 1 solves smaller
-EMDs.  ``s`` scales the kernel relative to the sampled window; the tracker
-passes 1, because its scale search resamples the window instead
-(IemdTracker._search_scale says why).
+EMDs.  The kernel is not scaled with the window: the scale search resamples
+the window instead (IemdTracker._search_scale says why).
 """
 from __future__ import annotations
 
@@ -23,50 +22,48 @@ import numba
 import numpy as np
 
 
-def epanechnikov(pos: np.ndarray, bandwidth: float) -> np.ndarray:
-    """k(||c / h||^2) for (N, 2) positions."""
-    return np.maximum(0.0, 1.0 - (pos**2).sum(1) / bandwidth**2)
-
-
 def target_weights(code_weights: np.ndarray, pos: np.ndarray, bandwidth: float) -> np.ndarray:
-    """w_T,u = gamma k(||c_u/h||^2) |p_u|, normalized to sum 1 (eq. sparse target model)."""
-    w = epanechnikov(pos, bandwidth) * np.abs(code_weights)
-    total = w.sum()
-    if total <= 0:
-        raise ValueError("target histogram is empty (no patch has a non-zero code)")
-    return w / total
+    """w_T,u = gamma k(||c_u/h||^2) |p_u|, normalized to sum 1 (eq. sparse target model).
+
+    The candidate weights of the same patches with the kernel at the window centre (y = 0).
+    """
+    w, _ = candidate_weights(code_weights, pos, np.zeros(2), bandwidth)
+    if not w.any():
+        raise ValueError("target histogram is empty (no patch with a non-zero code inside the kernel)")
+    return w
 
 
-def candidate_weights(code_weights, pos, y, scale, bandwidth):
+def candidate_weights(code_weights, pos, y, bandwidth):
     """w_C,v(y) of eq. (sparse candidate model) and its Jacobian dw_C,v/dy.
 
-    ``pos`` are the fixed patch centres of the sampled candidate grid, ``y`` the
-    window centre (2,), both in normalized units of the sampling window; ``scale``
-    the window size relative to the sampling window.  Returns (w, dw_dy) with
-    shapes (N,) and (N, 2); w sums to 1 (all zeros if no patch is inside the kernel).
-    The normalization gamma(y) is differentiated too, so sum_v dw_v/dy = 0 and
-    the gradient does not depend on the arbitrary constant of the duals.
+    ``pos`` are the fixed patch centres of the sampled candidate grid and ``y``
+    the kernel centre (2,), both in normalized window units.  Returns (w, dw_dy)
+    with shapes (N,) and (N, 2); w sums to 1 (all zeros if no patch is inside
+    the kernel).  The normalization gamma(y) is differentiated too, so
+    sum_v dw_v/dy = 0 and the gradient does not depend on the arbitrary
+    constant of the duals.
     """
     return _candidate_weights(np.asarray(code_weights, dtype=np.float64), np.asarray(pos, dtype=np.float64),
-                              np.asarray(y, dtype=np.float64), float(scale), float(bandwidth))
+                              np.asarray(y, dtype=np.float64), float(bandwidth))
 
 
 @numba.njit(cache=True)
-def _candidate_weights(code_weights, pos, y, scale, bandwidth):
+def _candidate_weights(code_weights, pos, y, bandwidth):
     """One pass of :func:`candidate_weights` (it runs on every EMD evaluation: 25 -> 2 us)."""
     n = pos.shape[0]
     w = np.zeros(n)
     dw_dy = np.zeros((n, 2))
     total = 0.0
+    h2 = bandwidth * bandwidth
     for i in range(n):
-        rx, ry = (pos[i, 0] - y[0]) / scale, (pos[i, 1] - y[1]) / scale
-        k = 1.0 - (rx * rx + ry * ry) / bandwidth**2
+        rx, ry = pos[i, 0] - y[0], pos[i, 1] - y[1]
+        k = 1.0 - (rx * rx + ry * ry) / h2  # Epanechnikov profile k(||(c - y) / h||^2)
         if k > 0:
             q = abs(code_weights[i])
             w[i] = k * q
-            # d k / d y = 2 (c - y) / (s^2 h^2) inside the support, 0 outside.
-            dw_dy[i, 0] = q * 2.0 * rx / (scale * bandwidth**2)
-            dw_dy[i, 1] = q * 2.0 * ry / (scale * bandwidth**2)
+            # d k / d y = 2 (c - y) / h^2 inside the support, 0 outside.
+            dw_dy[i, 0] = q * 2.0 * rx / h2
+            dw_dy[i, 1] = q * 2.0 * ry / h2
             total += w[i]
     if total <= 0:
         return np.zeros(n), np.zeros((n, 2))

@@ -5,7 +5,7 @@ import pytest
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.candidate import CandidateModel
-from iemd_ros.emd import solve_emd
+from iemd_ros.emd import ground_distance, solve_emd
 from iemd_ros.histogram import candidate_weights
 
 
@@ -30,14 +30,29 @@ def model_setup():
     tracker.init(frame0, box)
     center = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
     model = CandidateModel(ImagePyramid(to_gray(frame1)), tracker.layout, center, np.array(box[2:], float),
-                             tracker.dictionary.coder, len(tracker.dictionary.templates), tracker._target.eps,
-                             tracker.config.alpha)
+                           tracker._target, tracker.dictionary.coder, len(tracker.dictionary.templates),
+                           tracker.config.alpha, tracker.config.kernel_bandwidth)
     return tracker, model
 
 
 def emd_at(tracker, model, y):
-    t = tracker._target
-    return model.evaluate(y, tracker.config.kernel_bandwidth, t.pos, t.eps, t.weights, "envelope")
+    return model.evaluate("envelope", y)
+
+
+@pytest.mark.parametrize("y", [(0.0, 0.0), (0.05, -0.03)])
+def test_candidate_emd_uses_the_ground_distance(model_setup, y):
+    """The model's compiled transport cost is eq. (ground distance) between the target bins and the
+    candidate bins inside the kernel, with the candidate positions relative to the kernel centre."""
+    tracker, model = model_setup
+    cfg, target = tracker.config, tracker._target
+    value, solution = model.emd(y)
+    w, _ = candidate_weights(model.code_weights, model.pos, y, cfg.kernel_bandwidth)
+    keep = w > 0
+    cost = ground_distance(target.eps, target.pos, model.eps[keep], model.pos[keep] - np.array(y), cfg.alpha)
+    reference = solve_emd(target.weights, w[keep], cost)
+    assert value == pytest.approx(reference.value, rel=1e-12, abs=1e-14)
+    assert np.allclose(solution.flow, reference.flow)
+    assert 0 < value < 1
 
 
 @pytest.mark.parametrize("y0", [(0.03, -0.02), (-0.05, 0.04), (0.08, 0.01)])
@@ -58,18 +73,18 @@ def test_paper_gradient_is_the_derivative_through_the_weights_only(model_setup):
     # A position where no model bin sits on the kernel boundary (there D* has a kink).
     y0 = next(np.array(y) for y in [(0.04, -0.03), (0.037, -0.021), (0.051, 0.013), (0.021, 0.033)]
               if np.abs(1 - ((model.pos - y) ** 2).sum(1) / cfg.kernel_bandwidth**2).min() > 1e-3)
-    _, grad_paper, _ = model.evaluate(y0, cfg.kernel_bandwidth, target.pos, target.eps, target.weights, "paper")
-    _, grad_full, _ = model.evaluate(y0, cfg.kernel_bandwidth, target.pos, target.eps, target.weights, "envelope")
+    _, grad_paper, _ = model.evaluate("paper", y0)
+    _, grad_full, _ = model.evaluate("envelope", y0)
     h = 1e-6
     probes = [y0 + d for d in (h, -h) for d in np.eye(2) * d]
-    keep = np.any([candidate_weights(model.code_weights, model.pos, y, 1.0, cfg.kernel_bandwidth)[0] > 0
+    keep = np.any([candidate_weights(model.code_weights, model.pos, y, cfg.kernel_bandwidth)[0] > 0
                    for y in [y0] + probes], axis=0)
     rel = model.pos[keep] - y0
     cost = model.appearance_cost[:, keep] + (1 - cfg.alpha) * (
         (target.pos[:, None, :] - rel[None, :, :]) ** 2).sum(-1)
 
     def frozen_cost_emd(y):
-        w, _ = candidate_weights(model.code_weights, model.pos, y, 1.0, cfg.kernel_bandwidth)
+        w, _ = candidate_weights(model.code_weights, model.pos, y, cfg.kernel_bandwidth)
         return solve_emd(target.weights, w[keep], cost).value
 
     fd = np.array([(frozen_cost_emd(y0 + h * e) - frozen_cost_emd(y0 - h * e)) / (2 * h) for e in np.eye(2)])
@@ -93,7 +108,7 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     size = np.array(box[2:], float)
 
     def emd(c):
-        value, grad, _ = tracker._evaluate(tracker._candidate(pyramid, c, size))
+        value, grad, _ = tracker._candidate(pyramid, c, size).evaluate("appearance")
         return value, grad / (size / 2)  # per image pixel
 
     _, grad = emd(center)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from iemd_ros.histogram import candidate_weights, epanechnikov, target_weights
+from iemd_ros.histogram import candidate_weights, target_weights
 from iemd_ros.sparse_coding import SparseCoder, lasso_objective, max_alignment_pooling
 
 
@@ -69,25 +69,30 @@ def test_max_alignment_pooling_by_hand():
         max_alignment_pooling(codes, 4)
 
 
-def test_epanechnikov_and_target_weights_by_hand():
+def test_target_weights_by_hand():
+    """Epanechnikov profile 1 - ||c / h||^2 (zero outside) times |p|, normalized."""
     pos = np.array([[0.0, 0.0], [0.5, 0.0], [0.6, 0.8], [1.0, 1.0]])
-    assert np.allclose(epanechnikov(pos, 1.0), [1.0, 0.75, 0.0, 0.0])
-    assert np.allclose(epanechnikov(pos, 2.0), [1.0, 1 - 0.0625, 0.75, 0.5])
-    w = target_weights(np.array([2.0, 1.0, 5.0, 1.0]), pos, 1.0)
-    assert np.allclose(w, np.array([2.0, 0.75, 0.0, 0.0]) / 2.75)
+    codes = np.array([2.0, 1.0, 5.0, -1.0])
+    # h = 1: profile (1, 0.75, 0, 0)
+    assert np.allclose(target_weights(codes, pos, 1.0), np.array([2.0, 0.75, 0.0, 0.0]) / 2.75)
+    # h = 2: profile (1, 1 - 0.0625, 0.75, 0.5); |p| of the negative code
+    expected = np.array([2.0, 0.9375, 3.75, 0.5])
+    assert np.allclose(target_weights(codes, pos, 2.0), expected / expected.sum())
     with pytest.raises(ValueError, match="empty"):
         target_weights(np.zeros(4), pos, 1.0)
+    with pytest.raises(ValueError, match="empty"):
+        target_weights(np.array([0.0, 0.0, 1.0, 1.0]), pos, 1.0)  # codes only outside the kernel
 
 
 def test_candidate_weights_jacobian_matches_finite_differences():
     rng = np.random.default_rng(5)
     pos = rng.uniform(-1.2, 1.2, (60, 2))
     q = rng.uniform(0, 1, 60)
-    y, scale = np.array([0.1, -0.05]), 1.02
-    w, dw = candidate_weights(q, pos, y, scale, 1.0)
+    y = np.array([0.1, -0.05])
+    w, dw = candidate_weights(q, pos, y, 1.02)
     assert w.sum() == pytest.approx(1.0)
     assert np.allclose(dw.sum(0), 0.0, atol=1e-12)  # normalization is differentiated too
     h = 1e-7
     for k, e in enumerate(np.eye(2)):
-        fd = (candidate_weights(q, pos, y + h * e, scale, 1.0)[0] - candidate_weights(q, pos, y - h * e, scale, 1.0)[0]) / (2 * h)
+        fd = (candidate_weights(q, pos, y + h * e, 1.02)[0] - candidate_weights(q, pos, y - h * e, 1.02)[0]) / (2 * h)
         assert np.allclose(dw[:, k], fd, atol=1e-6)
