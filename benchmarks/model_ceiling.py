@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""How good can iEMD's appearance model be?  Its ceiling against a plain template, on real sequences.
+
+    python benchmarks/model_ceiling.py [--sequences Car4,Bolt2,Woman] [--stride 10] [--jump 3]
+
+For every ``stride``-th frame k, with the target model of frame 1 (no template update):
+
+* grid argmin: the window of the ground-truth size with the lowest score on a 13 x 13 grid of
+  offsets within +-0.6 window sizes of the ground truth; its IoU with the ground truth.  Scores: the
+  EMD of iEMD, and as a peer the negative normalized cross-correlation (NCC) of the frame-1 window
+  resampled to the template size.  This is what a perfect search could reach with the model.
+* one step: the tracker started from the ground truth of frame k - ``jump`` and updated on frame k
+  (IoU with the ground truth of k), against staying at the start.
+
+All numbers are mean IoU in %.
+"""
+from __future__ import annotations
+
+import argparse
+from multiprocessing import Pool
+
+import numpy as np
+
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.appearance import ImagePyramid, to_gray
+from iemd_ros.gyro import box_centre
+from iemd_ros.metrics import iou
+from iemd_ros.otb import default_root, load_sequence, read_frame
+
+OFFSETS = np.linspace(-0.6, 0.6, 13)
+SEQUENCES = "Bolt2,Car4,Couple,David,Deer,DragonBaby,Freeman1,Jogging-1,Jogging-2,MotorRolling,Skiing,Woman"
+
+
+def _grid_argmin_iou(score, truth) -> float:
+    """IoU with ``truth`` of the window of the lowest ``score(centre)`` on the offset grid."""
+    centre, size = box_centre(truth), truth[2:]
+    values = np.array([[score(centre + (dx * size[0], dy * size[1])) for dx in OFFSETS] for dy in OFFSETS])
+    iy, ix = np.unravel_index(np.argmin(values), values.shape)
+    best = (truth[0] + OFFSETS[ix] * size[0], truth[1] + OFFSETS[iy] * size[1], size[0], size[1])
+    return float(iou(np.array([best]), truth[None])[0])
+
+
+def measure(job):
+    name, stride, jump = job
+    seq = load_sequence(name, default_root())
+    first = read_frame(seq.frame_paths[0])
+    tracker = IemdTracker(TrackerConfig(update_templates=False))
+    tracker.init(first, seq.gt_boxes[0])
+    template_size = tracker.config.template_size
+    first_box = np.asarray(seq.gt_boxes[0], dtype=float)
+    reference = ImagePyramid(to_gray(first)).sample(box_centre(first_box), first_box[2:], template_size).ravel()
+    rows = []
+    for k in range(max(stride, jump), len(seq), stride):
+        truth = np.asarray(seq.gt_boxes[k], dtype=float)
+        frame = read_frame(seq.frame_paths[k])
+        pyramid = ImagePyramid(to_gray(frame))
+        size = truth[2:]
+
+        def emd(centre):
+            return tracker._candidate(pyramid, centre, size).emd()[0]
+
+        def ncc(centre):
+            window = pyramid.sample(centre, size, template_size).ravel()
+            return -np.corrcoef(reference, window)[0, 1]
+
+        start = np.asarray(seq.gt_boxes[k - jump], dtype=float)
+        tracker._center, tracker._size, tracker._angle, tracker._lost = box_centre(start), start[2:].copy(), 0.0, False
+        stepped = tracker.update(frame).box
+        rows.append((_grid_argmin_iou(emd, truth), _grid_argmin_iou(ncc, truth),
+                     iou(np.array([stepped]), truth[None])[0], iou(start[None], truth[None])[0]))
+    return name, 100.0 * np.mean(rows, axis=0)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sequences", default=SEQUENCES)
+    parser.add_argument("--stride", type=int, default=10)
+    parser.add_argument("--jump", type=int, default=3)
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args()
+    jobs = [(name, args.stride, args.jump) for name in args.sequences.split(",")]
+    with Pool(args.jobs) as pool:
+        results = pool.map(measure, jobs)
+    print(f"{'sequence':14s} {'grid EMD':>9s} {'grid NCC':>9s} {'step iEMD':>10s} {'stay':>6s}   (mean IoU %)")
+    for name, values in results:
+        print(f"{name:14s} {values[0]:9.1f} {values[1]:9.1f} {values[2]:10.1f} {values[3]:6.1f}")
+    mean = np.mean([values for _, values in results], axis=0)
+    print(f"{'mean':14s} {mean[0]:9.1f} {mean[1]:9.1f} {mean[2]:10.1f} {mean[3]:6.1f}")
+
+
+if __name__ == "__main__":
+    main()
