@@ -23,7 +23,7 @@ import numpy as np
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.gyro import box_centre
+from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
 from iemd_ros.otb import default_root, load_sequence, read_frame
 

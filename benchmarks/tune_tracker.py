@@ -21,9 +21,8 @@ import numpy as np
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.evaluation import IemdAdapter, run_tracker
-from iemd_ros.gyro import box_centre
-from iemd_ros.metrics import average_overlap, iou
+from iemd_ros.evaluation import IemdAdapter, evaluate_sequence
+from iemd_ros.boxes import box_centre
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
 
@@ -32,9 +31,8 @@ def overlap(job):
     seq = load_sequence(name, default_root())
     if frames:
         seq = seq.head(frames)
-    adapter = IemdAdapter(TrackerConfig(**config))
-    run = run_tracker(adapter, seq.frames(), seq.gt_boxes[0])
-    return average_overlap(iou(run.boxes, seq.gt_boxes)), float(np.median(run.update_seconds) * 1e3)
+    scores, run = evaluate_sequence(seq, IemdAdapter(TrackerConfig(**config)))
+    return scores.average_overlap, float(np.median(run.update_seconds) * 1e3)
 
 
 def discrimination(job, radius=40, grid=4):

@@ -311,7 +311,7 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
 
 def write_gt(path, boxes: np.ndarray, flags=None) -> None:
     """Ground truth as 1-based ``x,y,w,h`` lines (``NaN`` where absent; the flag as a 5th column if given),
-    readable by :func:`iemd_ros.otb.parse_groundtruth` (4 columns) / :func:`iemd_ros.recordings.load_gt_boxes`."""
+    readable by :func:`iemd_ros.otb.parse_groundtruth` (``with_flags=True`` for the 5th column)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("w", newline="") as f:

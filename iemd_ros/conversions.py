@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 
 from .camera import CameraModel
-from .gyro import box_centre
+from .boxes import box_centre, centre_box
 
 __all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "camera_model_from_info", "camera_model_from_msg",
            "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box"]
@@ -153,7 +153,7 @@ def box_to_bbox(box) -> tuple[float, float, float, float]:
     """Tracker box ``(x, y, w, h)`` -> ``vision_msgs/BoundingBox2D`` ``(center_x, center_y, size_x, size_y)``.
 
     The centre is in pixel-index coordinates (pixel centres at integers, as ``K``):
-    ``x + (w - 1) / 2`` (:func:`iemd_ros.gyro.box_centre`); the size is ``w, h`` pixels.
+    ``x + (w - 1) / 2`` (:func:`iemd_ros.boxes.box_centre`); the size is ``w, h`` pixels.
     """
     b = np.asarray(box, dtype=float).ravel()
     if b.shape != (4,):
@@ -168,4 +168,4 @@ def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) 
     if not np.all(np.isfinite(v)) or v[2] <= 0 or v[3] <= 0:
         raise ValueError(f"bounding box needs a finite centre and a positive size, got centre ({center_x}, "
                          f"{center_y}), size {size_x} x {size_y}")
-    return (float(v[0] - (v[2] - 1) / 2), float(v[1] - (v[3] - 1) / 2), float(v[2]), float(v[3]))
+    return tuple(float(b) for b in centre_box(v[:2], v[2:]))

@@ -157,8 +157,9 @@ def run_tracker(tracker: TrackerAdapter, frames, init_box) -> RunResult:
     return RunResult(np.vstack(boxes), np.asarray(oks, dtype=bool), init_s, np.asarray(times))
 
 
-def evaluate_sequence(seq: Sequence, tracker_name: str) -> tuple[SequenceScores, RunResult]:
-    run = run_tracker(make_tracker(tracker_name), seq.frames(), seq.gt_boxes[0])
+def evaluate_sequence(seq: Sequence, tracker: TrackerAdapter) -> tuple[SequenceScores, RunResult]:
+    """One-pass run of a fresh ``tracker`` on ``seq`` and its scores."""
+    run = run_tracker(tracker, seq.frames(), seq.gt_boxes[0])
     return score_sequence(run.boxes, seq.gt_boxes, seq.name, fps=run.fps), run
 
 
@@ -289,7 +290,7 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
     per_seq_scores: dict[str, list[SequenceScores]] = {t: [] for t in trackers}
     for seq in sequences:
         for trk in trackers:
-            scores, run = evaluate_sequence(seq, trk)
+            scores, run = evaluate_sequence(seq, make_tracker(trk))
             per_seq_scores[trk].append(scores)
             entry = scores.to_dict()
             entry.update(

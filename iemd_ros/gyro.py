@@ -23,7 +23,7 @@ translation so the box centre is mapped *exactly*; the corner residual is report
 Coordinates: points, ``H`` and the prior are in pixel-index coordinates (pixel centres at integers,
 as ``K``, OpenCV and the tracker's ``update(frame, prior)``).  A box ``(x, y, w, h)`` covers pixels
 ``x .. x+w-1`` (0-based), i.e. the region ``[x-0.5, x+w-0.5]``, centre ``x + (w-1)/2``
-(:func:`box_centre`), the tracker's convention.
+(:func:`iemd_ros.boxes.box_centre`), the tracker's convention.
 """
 from __future__ import annotations
 
@@ -32,11 +32,12 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .boxes import centre_box
 from .camera import CameraModel
 from .imu import Coverage, ImuBuffer, ImuIntegration
 from .rotation import GyroCalibration, StillBiasEstimator
 
-__all__ = ["rotation_homography", "warp_points", "box_centre", "box_grid", "local_prior", "predict_box",
+__all__ = ["rotation_homography", "warp_points", "box_grid", "local_prior", "predict_box",
            "warp_difference", "GyroConfig", "GyroPrediction", "GyroPredictor"]
 
 
@@ -75,12 +76,6 @@ def _check_box(box) -> np.ndarray:
     if b.shape != (4,) or not np.all(np.isfinite(b)) or b[2] <= 0 or b[3] <= 0:
         raise ValueError(f"box must be finite (x, y, w, h) with w, h > 0, got {np.asarray(box).tolist()}")
     return b
-
-
-def box_centre(box) -> np.ndarray:
-    """Centre ``(x + (w-1)/2, y + (h-1)/2)`` of (..., 4) boxes in pixel-index coordinates."""
-    b = np.asarray(box, dtype=float)
-    return b[..., :2] + (b[..., 2:] - 1.0) / 2.0
 
 
 def box_grid(box) -> np.ndarray:
@@ -145,7 +140,7 @@ def _box_from_grid(g) -> np.ndarray:
     tl, tr, br, bl, c = g[0], g[1], g[2], g[3], g[8]
     w = 0.5 * (np.hypot(*(tr - tl)) + np.hypot(*(br - bl)))
     h = 0.5 * (np.hypot(*(bl - tl)) + np.hypot(*(br - tr)))
-    return np.array([c[0] - (w - 1) / 2, c[1] - (h - 1) / 2, w, h])
+    return centre_box(c, (w, h))
 
 
 def warp_difference(frame_prev, frame_cur, H, valid=None, erode: int = 5) -> float:

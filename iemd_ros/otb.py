@@ -59,35 +59,42 @@ def read_frame(path: str | Path) -> np.ndarray:
     return img
 
 
-def parse_groundtruth(path: str | Path) -> np.ndarray:
-    """Parse an OTB GT file into 0-based ``(x, y, w, h)`` boxes, shape (N, 4) float.
+def parse_groundtruth(path: str | Path, with_flags: bool = False):
+    """Parse a GT file into 0-based ``(x, y, w, h)`` boxes, shape (N, 4) float.
 
-    Each non-empty line is split on ``[,\\s]+`` and must hold exactly four numbers ("NaN" is allowed
-    and marks an absent target).
+    Each non-empty line is split on ``[,\\s]+`` and must hold exactly four numbers; a box with a
+    non-finite value ("NaN") marks an absent target and becomes all NaN.  With ``with_flags`` a line
+    may carry a 5th flag column (default "ok"; "absent" also gives a NaN box) and ``(boxes, flags)``
+    is returned, flags an (N,) str array.
     """
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8", errors="strict")
     except (OSError, UnicodeDecodeError) as exc:
         raise ValueError(f"cannot read ground truth {path}: {exc}") from None
-    rows = []
+    rows, flags = [], []
     for lineno, line in enumerate(text.splitlines(), start=1):
         line = line.strip()
         if not line:
             continue
         fields = _SPLIT.split(line)
+        flag = fields.pop() if with_flags and len(fields) == 5 else "ok"
         try:
             values = [float(f) for f in fields]
         except ValueError:
-            raise ValueError(f"{path}:{lineno}: not a number in ground-truth line {line!r}") from None
+            raise ValueError(f"{path}:{lineno}: not a number: bad box line {line!r}") from None
         if len(values) != 4:
-            raise ValueError(f"{path}:{lineno}: expected 4 values x,y,w,h, got {len(values)} in {line!r}")
+            want = "4 values x,y,w,h" + (" and an optional flag" if with_flags else "")
+            raise ValueError(f"{path}:{lineno}: expected {want}, got {len(fields)} in {line!r}")
+        if flag == "absent" or not np.all(np.isfinite(values)):
+            values = [np.nan] * 4
         rows.append(values)
+        flags.append(flag)
     if not rows:
         raise ValueError(f"{path}: ground-truth file has no boxes")
     boxes = np.asarray(rows, dtype=float)
     boxes[:, :2] -= 1.0  # 1-based -> 0-based
-    return boxes
+    return (boxes, np.array(flags)) if with_flags else boxes
 
 
 def _frames_of(folder: Path) -> tuple[list[Path], list[int]]:

@@ -24,9 +24,10 @@ import numpy as np
 
 from .camera import CameraModel
 from .gyro import GyroConfig, GyroPredictor
+from .otb import parse_groundtruth
 from .tracker import IemdTracker, TrackerConfig, TrackResult
 
-__all__ = ["Recording", "load_recording", "load_cmu", "load_phone", "load_gt_boxes", "track_recording",
+__all__ = ["Recording", "load_recording", "load_cmu", "load_phone", "track_recording",
            "CMU_TIME_OFFSET_NS"]
 
 #: The authors' ``Time_offset -20`` (ms): ``t_imu = t_file - 20 ms``.
@@ -89,30 +90,6 @@ def _rows(path: Path) -> list[list[str]]:
     return [r for r in csv.reader(lines[1:])]
 
 
-def load_gt_boxes(path) -> tuple[np.ndarray, np.ndarray]:
-    """OTB-style ``x,y,w,h[,flag]`` lines (1-based) -> 0-based (N, 4) boxes (NaN where absent) and flags."""
-    boxes, flags = [], []
-    for n, line in enumerate(_need(Path(path)).read_text().splitlines(), 1):
-        if not line.strip():
-            continue
-        parts = [p.strip() for p in line.replace("\t", ",").split(",")]
-        try:
-            b = [float(p) for p in parts[:4]]
-        except ValueError as exc:
-            raise ValueError(f"{path}:{n}: bad box line {line!r}") from exc
-        if len(b) != 4:
-            raise ValueError(f"{path}:{n}: need x,y,w,h, got {line!r}")
-        flag = parts[4] if len(parts) > 4 else "ok"
-        if flag == "absent" or not np.all(np.isfinite(b)):
-            b = [np.nan] * 4
-        else:
-            b[0] -= 1.0
-            b[1] -= 1.0
-        boxes.append(b)
-        flags.append(flag)
-    return np.array(boxes, dtype=float).reshape(-1, 4), np.array(flags)
-
-
 def load_cmu(root) -> Recording:
     """Load ``cmu_hwangbo_desk`` or ``cmu_hwangbo_aerial`` (the sequence name comes from ``*_img.log``)."""
     root = Path(root)
@@ -140,7 +117,7 @@ def load_cmu(root) -> Recording:
     camera = CameraModel.from_yaml(root / "derived_camera_info.yaml")
     gt = flags = None
     if (root / "gt_eagle_head.txt").exists():
-        gt, flags = load_gt_boxes(root / "gt_eagle_head.txt")
+        gt, flags = parse_groundtruth(root / "gt_eagle_head.txt", with_flags=True)
         if len(gt) != len(files):
             raise ValueError(f"{root / 'gt_eagle_head.txt'} has {len(gt)} boxes for {len(files)} frames")
     return Recording(seq, root, files, stamps, CMU_TIME_OFFSET_NS, _ms_to_ns(imu[:, 0]), imu[:, 1:4], camera,

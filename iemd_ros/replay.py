@@ -124,15 +124,8 @@ def parse_box(text: str) -> tuple[float, float, float, float]:
 def load_gt(path) -> np.ndarray:
     """Ground truth (N, 4), 0-based: OTB ``x,y,w,h`` lines or the desk ``x,y,w,h,flag`` lines."""
     from .otb import parse_groundtruth
-    from .recordings import load_gt_boxes
 
-    path = Path(path)
-    try:
-        first = next((ln for ln in path.read_text().splitlines() if ln.strip()), "")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"cannot read ground truth {path}: {exc}") from None
-    n_fields = len([f for f in first.replace("\t", ",").replace(" ", ",").split(",") if f])
-    return load_gt_boxes(path)[0] if n_fields == 5 else parse_groundtruth(path)
+    return parse_groundtruth(path, with_flags=True)[0]
 
 
 def _fmt(v) -> str:

@@ -16,7 +16,7 @@ Clocks: true time is the IMU clock; frame stamps are ``t_true - time_offset`` so
 Ground truth, per frame: ``gt_boxes`` (x, y, w, h), the axis-aligned box of the target's projected
 outline (through the lens) in the tracker's convention (the box covers pixels x .. x+w-1, region
 ``[x-0.5, x+w-0.5]``); ``gt_centres``, the image of the target's centre in pixel-index coordinates
-(as K; compare with :func:`iemd_ros.gyro.box_centre`).
+(as K; compare with :func:`iemd_ros.boxes.box_centre`).
 """
 from __future__ import annotations
 

@@ -14,6 +14,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from .appearance import ImagePyramid, PatchLayout, to_gray
+from .boxes import box_centre, centre_box
 from .candidate import CandidateModel, TargetModel
 from .sparse_coding import max_alignment_pooling
 from .template import TemplateDictionary
@@ -145,7 +146,7 @@ class IemdTracker:
         _check_frame(frame)
         x, y, w, h = _check_box(box, frame.shape)
         cfg = self.config
-        self._center = np.array([x + (w - 1) / 2.0, y + (h - 1) / 2.0])
+        self._center = box_centre((x, y, w, h))
         self._size = np.array([w, h], dtype=np.float64)
         self._angle = self._search_angle = 0.0
         pyramid = ImagePyramid(to_gray(frame))
@@ -379,7 +380,7 @@ def _box(center, size, angle: float = 0.0):
     """Axis-aligned box (x, y, w, h) around the window, rotated by ``angle`` about its centre."""
     c, s = abs(np.cos(angle)), abs(np.sin(angle))
     w, h = c * size[0] + s * size[1], s * size[0] + c * size[1]
-    return (float(center[0] - (w - 1) / 2.0), float(center[1] - (h - 1) / 2.0), float(w), float(h))
+    return tuple(float(v) for v in centre_box(center, (w, h)))
 
 
 def _wrap_angle(angle: float) -> float:
@@ -394,7 +395,7 @@ def _particle_offsets(n: int, distance: float) -> np.ndarray:
 
 def _visible_fraction(center, size, shape) -> float:
     h_img, w_img = shape[:2]
-    x0, y0 = center - (size - 1) / 2.0
+    x0, y0 = centre_box(center, size)[:2]
     ix = max(0.0, min(x0 + size[0], w_img) - max(x0, 0.0))
     iy = max(0.0, min(y0 + size[1], h_img) - max(y0, 0.0))
     return ix * iy / float(size[0] * size[1])

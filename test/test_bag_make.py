@@ -11,8 +11,8 @@ from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
 
 from iemd_ros.bag_io import custom_data, open_bag
 from iemd_ros.bag_make import DEFAULT_TOPICS, main, source_from_folder, write_bag
-from iemd_ros.otb import load_sequence
-from iemd_ros.recordings import load_gt_boxes, load_recording
+from iemd_ros.otb import load_sequence, parse_groundtruth
+from iemd_ros.recordings import load_recording
 
 REPO = Path(__file__).resolve().parents[1]
 IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT_TOPICS["imu"]
@@ -131,7 +131,7 @@ def test_cmu_desk_excerpt(imu_root, tmp_path):
     assert imus[0].header.frame_id == imgs[0].header.frame_id == "camera_optical_frame"
     np.testing.assert_allclose(np.asarray(infos[0].k).reshape(3, 3), rec.camera.K)
     np.testing.assert_allclose(infos[0].d, rec.camera.D)
-    gt, flags = load_gt_boxes(tmp_path / "gt.txt")
+    gt, flags = parse_groundtruth(tmp_path / "gt.txt", with_flags=True)
     np.testing.assert_allclose(gt, rec.gt_boxes[10:15], atol=1e-9)
     assert list(flags) == list(rec.gt_flags[10:15])
 
@@ -152,8 +152,6 @@ def test_otb_folder(otb_root, tmp_path):
     msgs = read_all(tmp_path / "deer")
     assert {t for t, _, _, _ in msgs} == {IMG}                      # OTB: no IMU, no calibration
     np.testing.assert_array_equal(np.diff(stamps(by_topic(msgs, IMG))), 40_000_000)
-    from iemd_ros.otb import parse_groundtruth
-
     np.testing.assert_allclose(parse_groundtruth(tmp_path / "gt.txt"), seq.gt_boxes[:5], atol=1e-9)
 
 

@@ -4,6 +4,7 @@ import array
 import numpy as np
 import pytest
 
+from iemd_ros.boxes import box_centre, centre_box
 from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info,
                                   image_to_array, ns_to_stamp, stamp_to_ns)
 
@@ -105,3 +106,9 @@ def test_box_bbox_round_trip():
         bbox_to_box(1, 1, 0, 5)
     with pytest.raises(ValueError, match="finite"):
         bbox_to_box(float("nan"), 1, 3, 5)
+
+
+def test_box_centre_and_centre_box_are_inverse():
+    boxes = np.array([[10, 20, 4, 6], [-0.5, 3.25, 7, 1]])
+    np.testing.assert_array_equal(box_centre(boxes), [[11.5, 22.5], [2.5, 3.25]])
+    np.testing.assert_array_equal(centre_box(box_centre(boxes), boxes[:, 2:]), boxes)

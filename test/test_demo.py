@@ -6,7 +6,7 @@ import numpy as np
 
 from iemd_ros.demo import main
 from iemd_ros.metrics import iou
-from iemd_ros.recordings import load_gt_boxes
+from iemd_ros.otb import parse_groundtruth
 from iemd_ros.replay import replay
 
 N = 12
@@ -25,7 +25,7 @@ def test_demo_end_to_end(tmp_path, capsys):
     png = out / "demo.png"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
     assert f"plot: {png}" in text
-    gt, _ = load_gt_boxes(out / "ground_truth.txt")
+    gt, _ = parse_groundtruth(out / "ground_truth.txt", with_flags=True)
     assert gt.shape == (N, 4)
     g, ng = _boxes(out / "replay_gyro.csv"), _boxes(out / "replay_no_gyro.csv")
     assert len(g) == len(ng) == N

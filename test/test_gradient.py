@@ -4,6 +4,7 @@ import pytest
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
+from iemd_ros.boxes import box_centre
 from iemd_ros.candidate import CandidateModel
 from iemd_ros.emd import ground_distance, solve_emd
 from iemd_ros.histogram import candidate_weights
@@ -28,7 +29,7 @@ def model_setup():
     tracker = IemdTracker(TrackerConfig())
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
-    center = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
+    center = box_centre(box)
     model = CandidateModel(ImagePyramid(to_gray(frame1)), tracker.layout, center, np.array(box[2:], float),
                            tracker._target, tracker.dictionary.coder, len(tracker.dictionary.templates),
                            tracker.config.alpha, tracker.config.kernel_bandwidth)
@@ -104,7 +105,7 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
     pyramid = ImagePyramid(to_gray(frame1))
-    center = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
+    center = box_centre(box)
     size = np.array(box[2:], float)
 
     def emd(c):

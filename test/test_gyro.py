@@ -2,8 +2,9 @@
 import numpy as np
 import pytest
 
+from iemd_ros.boxes import box_centre
 from iemd_ros.camera import CameraModel
-from iemd_ros.gyro import (GyroConfig, GyroPredictor, box_centre, box_grid, local_prior, predict_box,
+from iemd_ros.gyro import (GyroConfig, GyroPredictor, box_grid, local_prior, predict_box,
                            rotation_homography, warp_difference, warp_points)
 from iemd_ros.imu import Coverage
 from iemd_ros.metrics import iou

@@ -16,7 +16,7 @@ from ros_harness import FRAME_ID, Driver, level, spinning, stamp_ns, values  # n
 from sensor_msgs.msg import Image  # noqa: E402
 
 from iemd_ros.conversions import image_to_array  # noqa: E402
-from iemd_ros.gyro import box_centre  # noqa: E402
+from iemd_ros.boxes import box_centre  # noqa: E402
 from iemd_ros.node import TrackerNode  # noqa: E402
 from iemd_ros.synthetic import generate  # noqa: E402
 

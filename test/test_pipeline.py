@@ -4,7 +4,8 @@ import math
 import numpy as np
 import pytest
 
-from iemd_ros.gyro import GyroConfig, GyroPredictor, box_centre
+from iemd_ros.boxes import box_centre
+from iemd_ros.gyro import GyroConfig, GyroPredictor
 from iemd_ros.pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
 from iemd_ros.synthetic import generate
 from iemd_ros.tracker import TrackerConfig

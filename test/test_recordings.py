@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from iemd_ros.recordings import CMU_TIME_OFFSET_NS, load_gt_boxes, load_recording
+from iemd_ros.otb import parse_groundtruth
+from iemd_ros.recordings import CMU_TIME_OFFSET_NS, load_recording
 
 
 def test_cmu_desk(imu_root):
@@ -36,14 +37,17 @@ def test_cmu_aerial_and_phone(imu_root):
 def test_gt_file_parsing(tmp_path):
     p = tmp_path / "gt.txt"
     p.write_text("10,20,30,40,ok\nNaN,NaN,NaN,NaN,absent\n1.5,2,3,4\n5,6,7,8,absent\n")
-    boxes, flags = load_gt_boxes(p)
+    boxes, flags = parse_groundtruth(p, with_flags=True)
     np.testing.assert_allclose(boxes[0], [9, 19, 30, 40])
     assert np.isnan(boxes[1]).all() and np.isnan(boxes[3]).all()
     np.testing.assert_allclose(boxes[2], [0.5, 1, 3, 4])
     assert list(flags) == ["ok", "absent", "ok", "absent"]
     p.write_text("1,2,x,4\n")
     with pytest.raises(ValueError, match="bad box line"):
-        load_gt_boxes(p)
+        parse_groundtruth(p, with_flags=True)
+    p.write_text("1 2 3 4 blur\n1,2,3,4,5,6\n")
+    with pytest.raises(ValueError, match=r"gt\.txt:2: expected 4 values x,y,w,h and an optional flag, got 6"):
+        parse_groundtruth(p, with_flags=True)
 
 
 def test_bad_folder(tmp_path):

@@ -5,6 +5,7 @@ import pytest
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
+from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
 from iemd_ros.otb import load_sequence, read_frame
 from iemd_ros.template import TemplateDictionary
@@ -134,9 +135,9 @@ def test_rotation_prior_turns_the_window_and_keeps_the_target():
     tracker = IemdTracker(config)
     tracker.init(frame0, box)
     result = tracker.update(frame1, prior=H)
-    center0 = np.array([box[0] + (box[2] - 1) / 2, box[1] + (box[3] - 1) / 2])
+    center0 = box_centre(box)
     expected = H[:2, :2] @ center0 + H[:2, 2]
-    got = np.array(result.box[:2]) + (np.array(result.box[2:]) - 1) / 2
+    got = box_centre(result.box)
     assert result.angle == pytest.approx(theta, abs=1e-9)
     assert np.linalg.norm(got - expected) < 0.5, (got, expected)
     assert result.box[2:] == pytest.approx((c * 50 + s * 30, s * 50 + c * 30), rel=1e-6)

@@ -1,0 +1,22 @@
+"""Box ``(x, y, w, h)`` <-> centre and size, in pixel-index coordinates (ROS-free).
+
+A box covers pixels ``x .. x+w-1`` (0-based), i.e. the region ``[x-0.5, x+w-0.5]``; its centre is
+``x + (w-1)/2`` (pixel centres at integers, as ``K``, OpenCV and the tracker).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["box_centre", "centre_box"]
+
+
+def box_centre(box) -> np.ndarray:
+    """Centre ``(x + (w-1)/2, y + (h-1)/2)`` of (..., 4) boxes."""
+    b = np.asarray(box, dtype=float)
+    return b[..., :2] + (b[..., 2:] - 1.0) / 2.0
+
+
+def centre_box(centre, size) -> np.ndarray:
+    """Inverse of :func:`box_centre`: (..., 4) boxes of the given centres and ``(w, h)`` sizes."""
+    c, s = np.asarray(centre, dtype=float), np.asarray(size, dtype=float)
+    return np.concatenate([c - (s - 1.0) / 2.0, s], axis=-1)
