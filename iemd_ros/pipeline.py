@@ -7,7 +7,7 @@ replay, so both produce the same boxes from the same messages:
     pipe = TrackingPipeline(PipelineConfig())
     pipe.set_camera(camera)                      # from CameraInfo (conversions.camera_model_from_msg)
     pipe.add_imu(t_ns, (wx, wy, wz))             # every Imu message (IMU frame, rad/s)
-    pipe.init(frame, (x, y, w, h), t_ns)         # start (or restart) on a frame
+    pipe.init(frame, (x, y, w, h), t_ns)         # start (or restart) on a frame: its FrameResult
     if pipe.gyro_ready(t_ns) or waited_long_enough:
         result = pipe.process(frame, t_ns)       # FrameResult
     pipe.statuses()                              # OK/WARN/ERROR summaries for /diagnostics
@@ -40,11 +40,12 @@ from .camera import CameraModel
 from .gyro import GyroConfig, GyroPredictor
 from .tracker import IemdTracker, TrackerConfig, compile_jit
 
-__all__ = ["PipelineConfig", "FrameResult", "Status", "TrackingPipeline", "OK", "WARN", "ERROR",
+__all__ = ["PipelineConfig", "FrameResult", "Status", "TrackingPipeline", "OK", "WARN", "ERROR", "INIT_REASON",
            "gyro_config_from_dict", "gyro_config_to_dict"]
 
 # levels of diagnostic_msgs/DiagnosticStatus
 OK, WARN, ERROR = 0, 1, 2
+INIT_REASON = "target initialized on this frame"   # FrameResult.reason of the frame init() started on
 
 _WINDOW = 30            # recent frames / IMU messages the statuses look at
 _LOST_ERROR_FRAMES = 30  # lost this many frames in a row: ERROR
@@ -394,22 +395,25 @@ class TrackingPipeline:
                 return True
             return self._predictor.ready(int(stamp_ns))
 
-    def init(self, frame: np.ndarray, box, stamp_ns: int) -> None:
+    def init(self, frame: np.ndarray, box, stamp_ns: int) -> FrameResult:
         """(Re)start tracking the target ``box`` = (x, y, w, h) in ``frame`` stamped ``stamp_ns``.
 
-        Raises ValueError for a bad frame or box (the previous target, if any, is kept then).
+        Returns the frame's result: ``box``, score 1, ``reason`` :data:`INIT_REASON`.  Raises
+        ValueError for a bad frame or box (the previous target, if any, is kept then).
         """
         with self._track_lock:
             tracker = IemdTracker(self._cfg.tracker)
             tracker.init(frame, box)
+            box = tuple(float(v) for v in box)
             with self._lock:
                 self._tracker = tracker
-                self._ref = (int(stamp_ns), tuple(float(v) for v in box), frame)
+                self._ref = (int(stamp_ns), box, frame)
                 self._state, self._lost_run = "tracking", 0
                 self.counters["inits"] += 1
                 self._last["frame_reason"] = ""
                 if self._last_stamp is None or int(stamp_ns) > self._last_stamp:
                     self._last_stamp = int(stamp_ns)
+        return FrameResult(int(stamp_ns), "tracking", box, score=1.0, reason=INIT_REASON)
 
     def reset(self) -> None:
         """Forget the target (state "uninitialized"); IMU and camera are kept."""

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from iemd_ros.gyro import GyroConfig, GyroPredictor, box_centre
-from iemd_ros.pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
+from iemd_ros.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
 from iemd_ros.synthetic import generate
 from iemd_ros.tracker import TrackerConfig
 
@@ -157,7 +157,8 @@ def test_gyro_ready_and_uninitialized_state(seq):
     assert r.state == "uninitialized" and r.box is None and r.score == 0.0
     assert p.statuses()[0].level == WARN and "initial_box" in p.statuses()[0].message
     assert p.gyro_ready(s[1])                      # no target: nothing to wait for
-    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    r = p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    assert (r.stamp_ns, r.box, r.score, r.reason) == (s[0], tuple(seq.gt_boxes[0]), 1.0, INIT_REASON) and r.tracking
     _feed_imu(p, seq, upto_ns=s[1] + seq.time_offset_ns - 1)
     assert not p.gyro_ready(s[1])                  # gyro stops just before the frame
     r = p.process(seq.frames[1], s[1])
