@@ -145,6 +145,7 @@ class TrackerNode(Node):
         self._ops: list = []                         # requests for the worker (config, reset, init)
         self._pending_box = self._initial_box        # initial_box to apply to the next frame
         self._latest_received = None
+        self._awaiting_imu: int | None = None        # stamp of the frame the worker holds for IMU coverage
         self._stop = False
         self._note = ""                              # latest init problem / internal error
         self._last_image_wall = self._last_imu_wall = None
@@ -276,8 +277,12 @@ class TrackerNode(Node):
         w = msg.angular_velocity
         if not self.pipeline.add_imu_message(t, (w.x, w.y, w.z), msg.angular_velocity_covariance[0]):
             self._warn(self.pipeline.last_reasons()["imu_reason"])
+        # Wake the worker only when this sample lets the frame it holds go.  No race: the sample is
+        # stored before the lock is taken here, and the worker sets _awaiting_imu and checks gyro_ready
+        # under the lock before it waits, so either it sees the sample or we see it waiting.
         with self._cond:
-            self._cond.notify_all()
+            if self._awaiting_imu is not None and self.pipeline.gyro_ready(self._awaiting_imu):
+                self._cond.notify_all()
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
         try:
@@ -396,11 +401,13 @@ class TrackerNode(Node):
         else:
             deadline = time.monotonic() + self.pipeline.config.imu_wait_ms * 1e-3
             with self._cond:
+                self._awaiting_imu = stamp
                 while not self._stop and not self.pipeline.gyro_ready(stamp):
                     remaining = deadline - time.monotonic()
                     if remaining <= 0:
                         break
                     self._cond.wait(remaining)
+                self._awaiting_imu = None
             result = self.pipeline.process(frame, stamp)
         self._publish(msg, result, received)
         self._publish_debug(msg, frame, result)
