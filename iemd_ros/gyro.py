@@ -33,7 +33,7 @@ import cv2
 import numpy as np
 
 from .camera import CameraModel
-from .imu import Coverage, ImuBuffer, ImuIntegration
+from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
 from .rotation import GyroCalibration, StillBiasEstimator
 
 __all__ = ["rotation_homography", "warp_points", "box_centre", "box_grid", "local_prior", "predict_box",
@@ -249,15 +249,15 @@ class GyroPredictor:
         """Current extrinsic + bias (the still-start estimate once available)."""
         return self._cal
 
-    def add_imu(self, t_ns, w) -> int:
-        """Add raw gyro samples (IMU frame, rad/s, stamps in ns on the IMU clock); returns #accepted."""
-        n = self.buffer.add(t_ns, w)
-        if not self.bias_estimator.done:
-            w2 = np.atleast_2d(np.asarray(w, dtype=float))
-            good = self.buffer.accepted(w2)
-            if good.any() and self.bias_estimator.update(w2[good]):
+    def add_imu(self, t_ns, w) -> np.ndarray:
+        """Add raw gyro samples (IMU frame, rad/s, stamps in ns on the IMU clock); returns their
+        :class:`~iemd_ros.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
+        status = self.buffer.add(t_ns, w)
+        good = status == SampleStatus.ACCEPTED
+        if not self.bias_estimator.done and good.any():
+            if self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
-        return n
+        return status
 
     def imu_time(self, t_cam_ns: int) -> int:
         """IMU-clock time of a camera stamp (``t_cam + time_offset_ns``)."""

@@ -38,6 +38,7 @@ import numpy as np
 
 from .camera import CameraModel
 from .gyro import GyroConfig, GyroPredictor
+from .imu import SampleStatus
 from .tracker import IemdTracker, TrackerConfig, compile_jit
 
 __all__ = ["PipelineConfig", "FrameResult", "Status", "TrackingPipeline", "OK", "WARN", "ERROR", "INIT_REASON",
@@ -338,7 +339,7 @@ class TrackingPipeline:
                 self._pending_imu.append((t, w))
                 self._imu_bad_run = 0
                 return True
-            if self._predictor.add_imu(t, w) == 0:
+            if self._predictor.add_imu(t, w)[0] == SampleStatus.SATURATED:   # finite: checked above
                 c["imu_saturated"] += 1
                 self._imu_bad_run += 1
                 self._last["imu_reason"] = (f"IMU sample at {t} ns rejected: |w| reaches the saturation limit "
