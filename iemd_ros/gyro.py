@@ -232,12 +232,13 @@ class GyroPredictor:
     Feed raw IMU-frame rates with :meth:`add_imu`; for consecutive frames call
     :meth:`predict` with their camera stamps (and the previous box).  If the gyro does not cover the
     new frame yet, the result has ``status == not_covered`` and no prior: wait a bounded time
-    (:meth:`ready`) and call again, or go on without the prior and log ``reason``.
+    (:meth:`ready`) and call again, or go on without the prior and log ``reason``.  ``camera`` may be
+    None until the calibration is known (set it then): samples are buffered, :meth:`predict` needs it.
     """
 
-    def __init__(self, camera: CameraModel, config: GyroConfig | None = None):
-        if not isinstance(camera, CameraModel):
-            raise ValueError(f"camera must be a CameraModel, got {type(camera).__name__}")
+    def __init__(self, camera: CameraModel | None, config: GyroConfig | None = None):
+        if camera is not None and not isinstance(camera, CameraModel):
+            raise ValueError(f"camera must be a CameraModel or None, got {type(camera).__name__}")
         self.camera = camera
         self.config = cfg = config if config is not None else GyroConfig()
         self._cal = GyroCalibration(cfg.R_cam_imu, cfg.bias)
@@ -278,6 +279,8 @@ class GyroPredictor:
         With ``box`` (frame k-1) the prior is fitted locally at the box and the predicted box is
         returned; without it the prior is the global ``H`` (exact only without lens distortion).
         """
+        if self.camera is None:
+            raise ValueError("no camera model: the gyro prior needs K")
         integ = self.rotation(t_prev_ns, t_cur_ns)
         usable = integ.ok or (integ.status is Coverage.GAP and self.config.allow_gaps)
         if not usable:

@@ -130,10 +130,24 @@ def test_imu_validation_counts_and_explains(seq):
     assert p.statuses()[2].level != ERROR
     p.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
     assert p.diagnostics()["imu_rejected"] == 13 and "covariance" in p.statuses()[2].message
-    # a clock reset (bag loop): the IMU buffer restarts
+    # a clock reset (bag loop): the IMU buffer restarts; a rejected sample stamped back there does not
+    assert not p.add_imu(t0 - 5_000_000_000, (np.nan, 0.0, 0.0))
+    assert p.diagnostics()["clock_resets"] == 0
     assert p.add_imu(t0 - 5_000_000_000, (0.0, 0.0, 0.0))
     d = p.diagnostics()
     assert d["clock_resets"] == 1 and d["imu_stored"] == 1 and "jumped back" in d["imu_reason"]
+
+
+def test_imu_before_camera_info_is_screened_and_held(seq):
+    p = _pipeline(seq, gyro={"time_offset_ns": seq.time_offset_ns, "saturation": 5.0})
+    t0 = int(seq.gyro_t_ns[0])
+    assert p.add_imu(t0, (0.0, 0.1, 0.0)) and p.add_imu(t0 + 5_000_000, (0.0, 0.1, 0.0))
+    assert not p.add_imu(t0 + 6_000_000, (np.nan, 0.0, 0.0)) and not p.add_imu(t0 + 7_000_000, (6.0, 0.0, 0.0))
+    d = p.diagnostics()
+    assert (d["imu_rejected"], d["imu_saturated"], d["imu_pending"], d["imu_stored"]) == (1, 1, 2, 2)
+    p.set_camera(seq.camera)
+    d = p.diagnostics()
+    assert (d["imu_pending"], d["imu_stored"]) == (0, 2)
 
 
 def test_frame_stamps_going_back_are_rejected_or_reset(seq):
