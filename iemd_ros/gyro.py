@@ -34,7 +34,7 @@ import numpy as np
 
 from .boxes import centre_box
 from .camera import CameraModel
-from .imu import Coverage, ImuBuffer, ImuIntegration
+from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
 from .rotation import GyroCalibration, StillBiasEstimator
 
 __all__ = ["rotation_homography", "warp_points", "box_grid", "local_prior", "predict_box",
@@ -227,12 +227,13 @@ class GyroPredictor:
     Feed raw IMU-frame rates with :meth:`add_imu`; for consecutive frames call
     :meth:`predict` with their camera stamps (and the previous box).  If the gyro does not cover the
     new frame yet, the result has ``status == not_covered`` and no prior: wait a bounded time
-    (:meth:`ready`) and call again, or go on without the prior and log ``reason``.
+    (:meth:`ready`) and call again, or go on without the prior and log ``reason``.  ``camera`` may be
+    None until the calibration is known (set it then): samples are buffered, :meth:`predict` needs it.
     """
 
-    def __init__(self, camera: CameraModel, config: GyroConfig | None = None):
-        if not isinstance(camera, CameraModel):
-            raise ValueError(f"camera must be a CameraModel, got {type(camera).__name__}")
+    def __init__(self, camera: CameraModel | None, config: GyroConfig | None = None):
+        if camera is not None and not isinstance(camera, CameraModel):
+            raise ValueError(f"camera must be a CameraModel or None, got {type(camera).__name__}")
         self.camera = camera
         self.config = cfg = config if config is not None else GyroConfig()
         self._cal = GyroCalibration(cfg.R_cam_imu, cfg.bias)
@@ -244,15 +245,15 @@ class GyroPredictor:
         """Current extrinsic + bias (the still-start estimate once available)."""
         return self._cal
 
-    def add_imu(self, t_ns, w) -> int:
-        """Add raw gyro samples (IMU frame, rad/s, stamps in ns on the IMU clock); returns #accepted."""
-        n = self.buffer.add(t_ns, w)
-        if not self.bias_estimator.done:
-            w2 = np.atleast_2d(np.asarray(w, dtype=float))
-            good = self.buffer.accepted(w2)
-            if good.any() and self.bias_estimator.update(w2[good]):
+    def add_imu(self, t_ns, w) -> np.ndarray:
+        """Add raw gyro samples (IMU frame, rad/s, stamps in ns on the IMU clock); returns their
+        :class:`~iemd_ros.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
+        status = self.buffer.add(t_ns, w)
+        good = status == SampleStatus.ACCEPTED
+        if not self.bias_estimator.done and good.any():
+            if self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
-        return n
+        return status
 
     def imu_time(self, t_cam_ns: int) -> int:
         """IMU-clock time of a camera stamp (``t_cam + time_offset_ns``)."""
@@ -273,6 +274,8 @@ class GyroPredictor:
         With ``box`` (frame k-1) the prior is fitted locally at the box and the predicted box is
         returned; without it the prior is the global ``H`` (exact only without lens distortion).
         """
+        if self.camera is None:
+            raise ValueError("no camera model: the gyro prior needs K")
         integ = self.rotation(t_prev_ns, t_cur_ns)
         usable = integ.ok or (integ.status is Coverage.GAP and self.config.allow_gaps)
         if not usable:

@@ -18,14 +18,14 @@ from __future__ import annotations
 
 import threading
 from dataclasses import dataclass
-from enum import Enum
+from enum import Enum, IntEnum
 
 import numba
 import numpy as np
 
 from .rotation import GyroCalibration, magnus_product, quat_to_rot, rot_to_quat
 
-__all__ = ["Coverage", "ImuIntegration", "ImuBuffer"]
+__all__ = ["Coverage", "SampleStatus", "ImuIntegration", "ImuBuffer"]
 
 _MERGE_EVERY = 512
 
@@ -38,6 +38,14 @@ class Coverage(str, Enum):
     NOT_COVERED = "not_covered"              # no sample at/after the window end yet: wait or go on
     START_NOT_COVERED = "start_not_covered"  # no sample at/before the window start (startup/dropped)
     NO_DATA = "no_data"                      # the buffer is empty
+
+
+class SampleStatus(IntEnum):
+    """What :meth:`ImuBuffer.add` did with a gyro sample (the one place samples are screened)."""
+
+    ACCEPTED = 0
+    NOT_FINITE = 1                           # NaN/inf rate: rejected
+    SATURATED = 2                            # |w_i| >= saturation: rejected
 
 
 @dataclass(frozen=True)
@@ -117,10 +125,11 @@ class ImuBuffer:
                            out_of_order=0, late=0, dropped=0)
 
     # ------------------------------------------------------------------ input
-    def add(self, t_ns, w) -> int:
+    def add(self, t_ns, w) -> np.ndarray:
         """Add one sample (``t_ns`` int, ``w`` (3,)) or many (``t_ns`` (N,), ``w`` (N, 3)).
 
-        ``w`` is the raw rate in rad/s in the IMU frame.  Returns the number of samples accepted.
+        ``w`` is the raw rate in rad/s in the IMU frame.  Returns the (N,) :class:`SampleStatus` of the
+        samples (NaN/inf and saturated ones are rejected and counted).
         """
         t = np.atleast_1d(np.asarray(t_ns))
         w = np.asarray(w, dtype=float)
@@ -132,15 +141,16 @@ class ImuBuffer:
             if not np.all(np.isfinite(t.astype(float))) or np.any(t != np.round(t)):
                 raise ValueError("gyro stamps must be integer nanoseconds")
         t = t.astype(np.int64)
-        finite, keep = self._screen(w)
+        status = self._screen(w)
+        keep = status == SampleStatus.ACCEPTED
         with self._lock:
             c = self.counts
             c["added"] += len(t)
-            c["nan"] += int((~finite).sum())
-            c["saturated"] += int((finite & ~keep).sum())
+            c["nan"] += int((status == SampleStatus.NOT_FINITE).sum())
+            c["saturated"] += int((status == SampleStatus.SATURATED).sum())
             t, w = t[keep], w[keep]
             if len(t) == 0:
-                return 0
+                return status
             # out of order w.r.t. arrival (clock stepping back included)
             prev_max = np.maximum.accumulate(np.concatenate([[self._t_max if self._t_max is not None else t[0]], t]))[:-1]
             c["out_of_order"] += int((t < prev_max).sum())
@@ -153,19 +163,16 @@ class ImuBuffer:
             self._n_pend += len(t)
             if self._n_pend >= _MERGE_EVERY:
                 self._merge()
-            return len(t)
+            return status
 
-    def _screen(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(finite, accepted) masks of (N, 3) rates: NaN/inf rejected, then ``|w_i| >= saturation``."""
+    def _screen(self, w: np.ndarray) -> np.ndarray:
+        """:class:`SampleStatus` of (N, 3) rates: NaN/inf rejected, then ``|w_i| >= saturation``."""
         finite = np.isfinite(w).all(axis=1)
-        keep = finite.copy()
+        status = np.where(finite, SampleStatus.ACCEPTED, SampleStatus.NOT_FINITE).astype(np.int8)
         if self.saturation is not None:
-            keep &= (np.abs(np.where(finite[:, None], w, 0.0)) < self.saturation).all(axis=1)
-        return finite, keep
-
-    def accepted(self, w) -> np.ndarray:
-        """Boolean mask of the (N, 3) rates this buffer accepts (finite and not saturated)."""
-        return self._screen(np.atleast_2d(np.asarray(w, dtype=float)))[1]
+            over = (np.abs(np.where(finite[:, None], w, 0.0)) >= self.saturation).any(axis=1)
+            status[over] = SampleStatus.SATURATED
+        return status
 
     def _merge(self) -> None:
         """Fold pending samples into the sorted store; merge equal stamps; enforce the memory bound."""

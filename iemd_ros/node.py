@@ -29,7 +29,6 @@ import time
 from collections import deque
 from dataclasses import fields
 
-import cv2
 import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -44,8 +43,9 @@ from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithP
 
 from .conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_msg, image_to_array,
                           stamp_ns)
+from .drawing import draw_result
 from .gyro import GyroConfig
-from .pipeline import ERROR, OK, WARN, PipelineConfig, TrackingPipeline, gyro_config_to_dict
+from .pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
 from .spin import spin_until_shutdown
 from .tracker import TrackerConfig
 
@@ -145,6 +145,7 @@ class TrackerNode(Node):
         self._ops: list = []                         # requests for the worker (config, reset, init)
         self._pending_box = self._initial_box        # initial_box to apply to the next frame
         self._latest_received = None
+        self._awaiting_imu: int | None = None        # stamp of the frame the worker holds for IMU coverage
         self._stop = False
         self._note = ""                              # latest init problem / internal error
         self._last_image_wall = self._last_imu_wall = None
@@ -276,8 +277,12 @@ class TrackerNode(Node):
         w = msg.angular_velocity
         if not self.pipeline.add_imu_message(t, (w.x, w.y, w.z), msg.angular_velocity_covariance[0]):
             self._warn(self.pipeline.last_reasons()["imu_reason"])
+        # Wake the worker only when this sample lets the frame it holds go.  No race: the sample is
+        # stored before the lock is taken here, and the worker sets _awaiting_imu and checks gyro_ready
+        # under the lock before it waits, so either it sees the sample or we see it waiting.
         with self._cond:
-            self._cond.notify_all()
+            if self._awaiting_imu is not None and self.pipeline.gyro_ready(self._awaiting_imu):
+                self._cond.notify_all()
 
     def _on_camera_info(self, msg: CameraInfo) -> None:
         try:
@@ -385,43 +390,42 @@ class TrackerNode(Node):
             pending_box, self._pending_box = self._pending_box, None
         if pending_box is not None:
             try:
-                self.pipeline.init(frame, pending_box, stamp)
+                result = self.pipeline.init(frame, pending_box, stamp)
             except ValueError as exc:
                 self._note = f"initial_box not usable: {exc}"
                 self._warn(self._note)
-                self._publish(msg, None, 0.0, received)
+                self._publish(msg, None, received)
                 return
             self._note = ""
             self.get_logger().info(f"target initialized at {pending_box}")
-            self._publish(msg, pending_box, 1.0, received)
-            self._publish_debug(msg, frame, None, pending_box)
-            return
-        deadline = time.monotonic() + self.pipeline.config.imu_wait_ms * 1e-3
-        with self._cond:
-            while not self._stop and not self.pipeline.gyro_ready(stamp):
-                remaining = deadline - time.monotonic()
-                if remaining <= 0:
-                    break
-                self._cond.wait(remaining)
-        result = self.pipeline.process(frame, stamp)
-        if result.tracking:
-            self._publish(msg, result.box, result.score, received)
         else:
-            self._publish(msg, None, 0.0, received)
-        self._publish_debug(msg, frame, result, None)
+            deadline = time.monotonic() + self.pipeline.config.imu_wait_ms * 1e-3
+            with self._cond:
+                self._awaiting_imu = stamp
+                while not self._stop and not self.pipeline.gyro_ready(stamp):
+                    remaining = deadline - time.monotonic()
+                    if remaining <= 0:
+                        break
+                    self._cond.wait(remaining)
+                self._awaiting_imu = None
+            result = self.pipeline.process(frame, stamp)
+        self._publish(msg, result, received)
+        self._publish_debug(msg, frame, result)
 
     # ------------------------------------------------------------------ output
-    def _publish(self, img: Image, box, score: float, received) -> None:
+    def _publish(self, img: Image, result: FrameResult | None, received) -> None:
+        """The image's Detection2DArray: one detection while ``result`` is tracking, else empty."""
         out = Detection2DArray()
         out.header = img.header
-        if box is not None:
+        if result is not None and result.tracking:
             det = Detection2D()
             det.header = img.header
             det.id = self._detection_id
-            det.bbox.center.position.x, det.bbox.center.position.y, det.bbox.size_x, det.bbox.size_y = box_to_bbox(box)
+            c = det.bbox.center.position
+            c.x, c.y, det.bbox.size_x, det.bbox.size_y = box_to_bbox(result.box)
             hyp = ObjectHypothesisWithPose()
             hyp.hypothesis.class_id = self._class_id
-            hyp.hypothesis.score = float(score)
+            hyp.hypothesis.score = float(result.score)
             det.results = [hyp]
             out.detections = [det]
         if self._stop or not self.context.ok():
@@ -430,28 +434,10 @@ class TrackerNode(Node):
         if received is not None:
             self._latency_ms.append((time.monotonic() - received) * 1e3)
 
-    def _publish_debug(self, img: Image, frame: np.ndarray, result, init_box) -> None:
+    def _publish_debug(self, img: Image, frame: np.ndarray, result: FrameResult) -> None:
         if self._debug_pub.get_subscription_count() == 0 or self._stop:
             return
-        canvas = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR) if frame.ndim == 2 else frame.copy()
-
-        def rect(box, colour, thick):
-            x, y, w, h = box
-            cv2.rectangle(canvas, (int(round(x)), int(round(y))), (int(round(x + w - 1)), int(round(y + h - 1))),
-                          colour, thick)
-
-        if init_box is not None:
-            rect(init_box, (255, 200, 0), 2)
-            text = "initialized"
-        elif result is None or result.box is None:
-            text = result.rejected or result.state if result is not None else ""
-        else:
-            if result.gyro_box is not None:
-                rect(result.gyro_box, (0, 220, 255), 1)
-            rect(result.box, (0, 200, 0) if result.tracking else (0, 0, 255), 2)
-            text = (f"{result.state} EMD {result.emd:.3f} it {result.iterations} "
-                    f"{'gyro' if result.gyro_used else 'no gyro'} {result.processing_ms:.0f} ms")
-        cv2.putText(canvas, text, (5, 15), cv2.FONT_HERSHEY_SIMPLEX, 0.45, (255, 255, 255), 1, cv2.LINE_AA)
+        canvas = draw_result(frame, result)
         out = Image()
         out.header = img.header
         f = array_to_image_fields(canvas)

@@ -7,7 +7,7 @@ replay, so both produce the same boxes from the same messages:
     pipe = TrackingPipeline(PipelineConfig())
     pipe.set_camera(camera)                      # from CameraInfo (conversions.camera_model_from_msg)
     pipe.add_imu(t_ns, (wx, wy, wz))             # every Imu message (IMU frame, rad/s)
-    pipe.init(frame, (x, y, w, h), t_ns)         # start (or restart) on a frame
+    pipe.init(frame, (x, y, w, h), t_ns)         # start (or restart) on a frame: its FrameResult
     if pipe.gyro_ready(t_ns) or waited_long_enough:
         result = pipe.process(frame, t_ns)       # FrameResult
     pipe.statuses()                              # OK/WARN/ERROR summaries for /diagnostics
@@ -32,24 +32,25 @@ import math
 import threading
 import time
 from collections import deque
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field, fields
 
 import numpy as np
 
 from .camera import CameraModel
 from .gyro import GyroConfig, GyroPredictor
+from .imu import SampleStatus
 from .tracker import IemdTracker, TrackerConfig, compile_jit
 
-__all__ = ["PipelineConfig", "FrameResult", "Status", "TrackingPipeline", "OK", "WARN", "ERROR",
+__all__ = ["PipelineConfig", "FrameResult", "Status", "TrackingPipeline", "OK", "WARN", "ERROR", "INIT_REASON",
            "gyro_config_from_dict", "gyro_config_to_dict"]
 
 # levels of diagnostic_msgs/DiagnosticStatus
 OK, WARN, ERROR = 0, 1, 2
+INIT_REASON = "target initialized on this frame"   # FrameResult.reason of the frame init() started on
 
 _WINDOW = 30            # recent frames / IMU messages the statuses look at
 _LOST_ERROR_FRAMES = 30  # lost this many frames in a row: ERROR
 _IMU_ERROR_RUN = 10      # this many rejected IMU messages in a row: ERROR
-_PROBE_CAMERA = CameraModel(np.eye(3))
 
 
 def gyro_config_from_dict(values: dict) -> GyroConfig:
@@ -75,7 +76,7 @@ def gyro_config_from_dict(values: dict) -> GyroConfig:
                 raise ValueError(f"gyro {key} must be an integer, got {v[key]!r}")
             v[key] = int(v[key])
     cfg = GyroConfig(**v)
-    GyroPredictor(_PROBE_CAMERA, cfg)       # the predictor's own checks (rotation, bias, buffer limits)
+    GyroPredictor(None, cfg)                # the predictor's own checks (rotation, bias, buffer limits)
     return cfg
 
 
@@ -198,14 +199,11 @@ class TrackingPipeline:
             raise ValueError("config must be a PipelineConfig")
         self._lock = threading.RLock()        # IMU / camera / counters (held briefly)
         self._track_lock = threading.RLock()  # tracker state (held during a tracker update)
-        self._camera: CameraModel | None = None
-        self._predictor: GyroPredictor | None = None
-        self._pending_imu: deque = deque(maxlen=self._cfg.gyro.buffer_samples)  # before camera_info
+        self._predictor = GyroPredictor(None, self._cfg.gyro)   # buffers the IMU from the start; K comes later
         self._tracker: IemdTracker | None = None
         self._state = "uninitialized"
         self._ref: tuple[int, tuple, np.ndarray] | None = None   # (stamp, window box, frame) the window is in
         self._last_stamp: int | None = None
-        self._last_imu_stamp: int | None = None
         self._lost_run = 0
         self.counters = dict(frames_received=0, frames_processed=0, frames_uninitialized=0, frames_dropped=0,
                              frames_rejected=0, images_malformed=0, frames_lost=0, gyro_used=0, gyro_unused=0,
@@ -232,7 +230,7 @@ class TrackingPipeline:
 
     @property
     def camera(self) -> CameraModel | None:
-        return self._camera
+        return self._predictor.camera
 
     def configure(self, config: PipelineConfig) -> str:
         """Apply a new configuration; returns a one-line summary of what changed.
@@ -247,7 +245,7 @@ class TrackingPipeline:
             old, self._cfg = self._cfg, config
             notes = []
             if not _same_gyro(config.gyro, old.gyro):
-                self._rebuild_predictor(keep_bias=False)
+                self._rebuild_predictor()
                 notes.append("gyro predictor rebuilt (IMU samples kept)")
             if config.tracker != old.tracker:
                 if self._tracker is not None and self._ref is not None:
@@ -268,12 +266,11 @@ class TrackingPipeline:
         with self._lock:
             self.counters["camera_infos"] += 1
             self._last["camera_error"] = ""
-            cur = self._camera
+            cur = self._predictor.camera
             if cur is not None and np.array_equal(cur.K, camera.K) and np.array_equal(cur.D, camera.D) \
                     and (cur.width, cur.height) == (camera.width, camera.height):
                 return False
-            self._camera = camera
-            self._rebuild_predictor(keep_bias=True)
+            self._predictor.camera = camera
             return True
 
     def note_bad_camera_info(self, reason: str) -> None:
@@ -282,69 +279,52 @@ class TrackingPipeline:
             self.counters["camera_infos_rejected"] += 1
             self._last["camera_error"] = reason
 
-    def _rebuild_predictor(self, keep_bias: bool) -> None:
-        """New GyroPredictor for the current camera/gyro config, fed the samples buffered so far."""
-        if self._camera is None:
-            return
-        cfg = self._cfg.gyro
-        old = self._predictor
-        if old is not None:
-            t, w = old.buffer.samples()
-            if keep_bias and old.bias_estimator.done:      # keep a still-start estimate already made
-                cfg = replace(cfg, bias=old.calibration.bias, still_bias_samples=0)
-        elif self._pending_imu:
-            t = np.array([s[0] for s in self._pending_imu], dtype=np.int64)
-            w = np.array([s[1] for s in self._pending_imu], dtype=float)
-            self._pending_imu.clear()
-        else:
-            t = np.zeros(0, np.int64)
-        self._predictor = GyroPredictor(self._camera, cfg)
+    def _rebuild_predictor(self) -> None:
+        """New GyroPredictor for the current gyro config, fed the samples buffered so far."""
+        t, w = self._predictor.buffer.samples()
+        self._predictor = GyroPredictor(self._predictor.camera, self._cfg.gyro)
         if len(t):
             self._predictor.add_imu(t, w)
 
     def add_imu(self, t_ns: int, gyro_xyz) -> bool:
         """Add one gyro sample (IMU clock, ns; IMU-frame rate in rad/s).  Returns False if rejected.
 
-        Non-finite rates and saturated samples are rejected and counted; a stamp earlier than the
-        previous one is counted (the buffer puts it in order) and, if earlier by more than
-        ``clock_reset_ms``, restarts the IMU buffer (a clock reset).  ``last_reasons()['imu_reason']``
-        says why.
+        Non-finite rates and saturated samples are rejected and counted (the IMU buffer screens them);
+        an accepted stamp earlier than the newest one is counted (the buffer puts it in order) and, if
+        earlier by more than ``clock_reset_ms``, restarts the IMU buffer (a clock reset).
+        ``last_reasons()['imu_reason']`` says why.  ValueError if ``gyro_xyz`` is not 3 values.
         """
-        w = np.asarray(gyro_xyz, dtype=float).ravel()
         t = int(t_ns)
+        w = np.asarray(gyro_xyz, dtype=float).ravel()
         with self._lock:
             c = self.counters
             c["imu_received"] += 1
-            if w.shape != (3,) or not np.all(np.isfinite(w)):
-                c["imu_rejected"] += 1
-                self._imu_bad_run += 1
-                self._last["imu_reason"] = (f"IMU sample at {t} ns rejected: angular velocity {w.tolist()} "
-                                            "is not 3 finite values")
-                return False
-            prev = self._last_imu_stamp
-            if prev is not None and t <= prev:
-                back = prev - t
-                if back > self._cfg.clock_reset_ms * 1e6:
-                    c["clock_resets"] += 1
-                    self._last["imu_reason"] = f"IMU clock jumped back by {_ms(back)}: IMU buffer restarted"
-                    self._clear_imu()
-                elif back > 0:
-                    c["imu_out_of_order"] += 1
-                    self._last["imu_reason"] = f"IMU stamp went back by {_ms(back)} (sample put in order)"
-            if self._last_imu_stamp is None or t > self._last_imu_stamp:
-                self._last_imu_stamp = t
-            if self._predictor is None:
-                self._pending_imu.append((t, w))
-                self._imu_bad_run = 0
-                return True
-            if self._predictor.add_imu(t, w) == 0:
-                c["imu_saturated"] += 1
-                self._imu_bad_run += 1
-                self._last["imu_reason"] = (f"IMU sample at {t} ns rejected: |w| reaches the saturation limit "
-                                            f"{self._cfg.gyro.saturation} rad/s")
-                return False
+            newest = self._predictor.buffer.t_newest_ns
+            status = self._predictor.add_imu(t, w)[0]
+            if status == SampleStatus.NOT_FINITE:
+                return self._reject_imu("imu_rejected", f"IMU sample at {t} ns rejected: angular velocity "
+                                                        f"{w.tolist()} is not 3 finite values")
+            if status == SampleStatus.SATURATED:
+                return self._reject_imu("imu_saturated", f"IMU sample at {t} ns rejected: |w| reaches the "
+                                                         f"saturation limit {self._cfg.gyro.saturation} rad/s")
+            back = 0 if newest is None else newest - t
+            if back > self._cfg.clock_reset_ms * 1e6:
+                c["clock_resets"] += 1
+                self._last["imu_reason"] = f"IMU clock jumped back by {_ms(back)}: IMU buffer restarted"
+                self._clear_imu()
+                self._predictor.add_imu(t, w)                 # the first sample on the new clock
+            elif back > 0:
+                c["imu_out_of_order"] += 1
+                self._last["imu_reason"] = f"IMU stamp went back by {_ms(back)} (sample put in order)"
             self._imu_bad_run = 0
             return True
+
+    def _reject_imu(self, counter: str, reason: str) -> bool:
+        """Count a rejected IMU message under ``counter``; returns False (add_imu's answer)."""
+        self.counters[counter] += 1
+        self._imu_bad_run += 1
+        self._last["imu_reason"] = reason
+        return False
 
     def add_imu_message(self, t_ns: int, angular_velocity_xyz, angular_velocity_covariance0: float) -> bool:
         """A sensor_msgs/Imu's rates: REP 145's covariance[0] = -1 means "no angular velocity"."""
@@ -357,15 +337,10 @@ class TrackingPipeline:
         """Count an IMU message that carries no usable rate (e.g. covariance[0] = -1: no gyro)."""
         with self._lock:
             self.counters["imu_received"] += 1
-            self.counters["imu_rejected"] += 1
-            self._imu_bad_run += 1
-            self._last["imu_reason"] = reason
+            self._reject_imu("imu_rejected", reason)
 
     def _clear_imu(self) -> None:
-        self._pending_imu.clear()
-        self._last_imu_stamp = None
-        if self._predictor is not None:
-            self._predictor = GyroPredictor(self._camera, self._cfg.gyro)
+        self._predictor = GyroPredictor(self._predictor.camera, self._cfg.gyro)
 
     def note_dropped(self, stamp_ns: int, reason: str = "a newer frame arrived before this one was processed") -> None:
         """Count a frame the caller skipped (e.g. stale: processing fell behind)."""
@@ -390,26 +365,29 @@ class TrackingPipeline:
         """True when processing the frame now loses nothing: the gyro covers it, or no prior can be
         used anyway (gyro off, no camera, no target).  False: waiting for IMU samples may help."""
         with self._lock:
-            if not self._cfg.use_gyro or self._predictor is None or self._ref is None:
+            if not self._cfg.use_gyro or self._predictor.camera is None or self._ref is None:
                 return True
             return self._predictor.ready(int(stamp_ns))
 
-    def init(self, frame: np.ndarray, box, stamp_ns: int) -> None:
+    def init(self, frame: np.ndarray, box, stamp_ns: int) -> FrameResult:
         """(Re)start tracking the target ``box`` = (x, y, w, h) in ``frame`` stamped ``stamp_ns``.
 
-        Raises ValueError for a bad frame or box (the previous target, if any, is kept then).
+        Returns the frame's result: ``box``, score 1, ``reason`` :data:`INIT_REASON`.  Raises
+        ValueError for a bad frame or box (the previous target, if any, is kept then).
         """
         with self._track_lock:
             tracker = IemdTracker(self._cfg.tracker)
             tracker.init(frame, box)
+            box = tuple(float(v) for v in box)
             with self._lock:
                 self._tracker = tracker
-                self._ref = (int(stamp_ns), tuple(float(v) for v in box), frame)
+                self._ref = (int(stamp_ns), box, frame)
                 self._state, self._lost_run = "tracking", 0
                 self.counters["inits"] += 1
                 self._last["frame_reason"] = ""
                 if self._last_stamp is None or int(stamp_ns) > self._last_stamp:
                     self._last_stamp = int(stamp_ns)
+        return FrameResult(int(stamp_ns), "tracking", box, score=1.0, reason=INIT_REASON)
 
     def reset(self) -> None:
         """Forget the target (state "uninitialized"); IMU and camera are kept."""
@@ -462,9 +440,8 @@ class TrackingPipeline:
             self._last["frame_reason"] = f"image clock jumped back by {_ms(back)}: treated as a clock reset"
             if self._ref is not None:
                 self._ref = (t, self._ref[1], self._ref[2])     # no rotation can be integrated across it
-            pred = self._predictor
-            if pred is not None and pred.buffer.t_newest_ns is not None \
-                    and pred.buffer.t_newest_ns > pred.imu_time(t) + self._cfg.clock_reset_ms * 1e6:
+            newest = self._predictor.buffer.t_newest_ns
+            if newest is not None and newest > self._predictor.imu_time(t) + self._cfg.clock_reset_ms * 1e6:
                 self._clear_imu()          # the IMU is still on the old clock
             return ""
         if back == 0:
@@ -475,7 +452,7 @@ class TrackingPipeline:
         """(prior or None, predicted box or None, reason) for the frame at ``t``."""
         if not self._cfg.use_gyro:
             return None, None, "gyro disabled (use_gyro is false)"
-        if self._predictor is None:
+        if self._predictor.camera is None:
             return None, None, "no camera_info received: the gyro prior needs K"
         t_ref, box, _ = self._ref
         if t == t_ref:
@@ -525,7 +502,8 @@ class TrackingPipeline:
             d.update(self._last)
             d["state"] = self._state
             d["lost_run"] = self._lost_run
-            d["camera"] = "none" if self._camera is None else repr(self._camera)
+            camera = self._predictor.camera
+            d["camera"] = "none" if camera is None else repr(camera)
             proc = list(self._recent_proc)
             d["processing_rate_hz"] = _rate([s for s, _, _ in proc])
             d["input_rate_hz"] = _rate([s for s, _ in self._recent])
@@ -538,10 +516,9 @@ class TrackingPipeline:
             r = self._last_result
             d["emd"] = math.nan if r is None else r.emd
             d["iterations"] = 0 if r is None else r.iterations
-            d["imu_stored"] = 0 if self._predictor is None else len(self._predictor.buffer)
-            d["imu_pending"] = len(self._pending_imu)
-            if self._predictor is not None:
-                d["bias_status"] = self._predictor.bias_estimator.status
+            d["imu_stored"] = len(self._predictor.buffer)
+            d["imu_pending"] = d["imu_stored"] if camera is None else 0     # held until camera_info
+            d["bias_status"] = self._predictor.bias_estimator.status
             d["imu_bad_run"] = self._imu_bad_run
             d["image_bad"] = self._image_bad
             return d
@@ -596,10 +573,10 @@ class TrackingPipeline:
         else:
             imu = (OK, f"gyro prior used on {d['recent_gyro_used']} of the last {d['recent_processed']} frames")
         keys = ["imu_received", "imu_rejected", "imu_out_of_order", "imu_saturated", "imu_stored", "imu_pending",
-                "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason"]
-        imu_status = Status(f"{prefix}: imu", *imu, vals(*keys, *(["bias_status"] if "bias_status" in d else [])))
+                "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status"]
+        imu_status = Status(f"{prefix}: imu", *imu, vals(*keys))
         # camera_info
-        if self._camera is None:
+        if self.camera is None:
             if d["camera_error"]:
                 cam = (ERROR, f"camera_info rejected: {d['camera_error']}")
             elif cfg.use_gyro:

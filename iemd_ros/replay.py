@@ -52,12 +52,12 @@ from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Pro
 from .camera import CameraModel
 from .cli import CliParser, cli_main
 from .conversions import box_to_bbox, camera_model_from_msg, image_to_array, stamp_ns
-from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
+from .drawing import draw_result
+from .pipeline import INIT_REASON, FrameResult, PipelineConfig, TrackingPipeline
 
 __all__ = ["ReplayResult", "replay", "parse_box", "load_gt", "write_csv", "CSV_HEADER", "main"]
 
 CSV_HEADER = ("stamp_ns", "x", "y", "w", "h", "emd", "state")
-INIT_REASON = "initialised with --init"
 # as the node publishes them (iemd_ros.node defaults: ``detections`` in the root namespace, class_id
 # "target", id "iemd"; one detection while tracking, none when lost; the init frame has score 1)
 DETECTIONS_TOPIC = "/detections"
@@ -164,12 +164,13 @@ class _OutBag:
         self.bag.add_topic(DETECTIONS_TOPIC, DETECTIONS_TYPE)
         self.bag.add_topic(DIAGNOSTICS_TOPIC, DIAGNOSTICS_TYPE)
 
-    def write(self, log_t: int, frame_id: str, r: FrameResult, statuses, publish_box: bool) -> None:
+    def write(self, log_t: int, frame_id: str, r: FrameResult, statuses) -> None:
+        """The frame's Detection2DArray (one detection while ``r`` is tracking, else empty) and statuses."""
         b = self.bag
         M = b.msg
         hdr = header(b, DETECTIONS_TOPIC, r.stamp_ns, frame_id)
         dets = []
-        if publish_box:
+        if r.tracking:
             cx, cy, sx, sy = box_to_bbox(r.box)
             hyp = M("vision_msgs/msg/ObjectHypothesisWithPose")(
                 hypothesis=M("vision_msgs/msg/ObjectHypothesis")(class_id=CLASS_ID, score=float(r.score)),
@@ -195,7 +196,7 @@ class _OutBag:
 
 
 class _Video:
-    """Annotated MP4 (mp4v): box (green tracking / red lost), gyro prediction (blue), stamp and EMD.
+    """Annotated MP4 (mp4v), each frame drawn by :func:`iemd_ros.drawing.draw_result`.
 
     The frame rate is the image rate of the bag: the first frame is held until the second one gives
     the interval."""
@@ -204,7 +205,7 @@ class _Video:
         self.path, self.writer, self._held = Path(path), None, None
 
     def write(self, frame: np.ndarray, r: FrameResult) -> None:
-        img = self._annotate(frame, r)
+        img = draw_result(frame, r)
         if self.writer is None:
             if self._held is None:
                 self._held = (img, r.stamp_ns)
@@ -223,29 +224,6 @@ class _Video:
                                       float(min(max(fps, 1.0), 240.0)), (w, h))
         if not self.writer.isOpened():
             raise ValueError(f"cannot write video {self.path} (OpenCV mp4v writer failed to open)")
-
-    @staticmethod
-    def _annotate(frame: np.ndarray, r: FrameResult) -> np.ndarray:
-        import cv2
-
-        img = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR) if frame.ndim == 2 else frame.copy()
-        if r.gyro_box is not None:
-            _Video._rect(img, r.gyro_box, (255, 128, 0), 1)
-        if r.box is not None:
-            _Video._rect(img, r.box, (0, 200, 0) if r.state != "lost" else (0, 0, 255), 2)
-        text = f"{r.stamp_ns / 1e9:.3f}s {r.state}" + ("" if math.isnan(r.emd) else f" emd {r.emd:.4f}") + \
-               (" gyro" if r.gyro_used else "")
-        cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 3, cv2.LINE_AA)
-        cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
-        return img
-
-    @staticmethod
-    def _rect(img, box, colour, thickness) -> None:
-        import cv2
-
-        x, y, w, h = box
-        cv2.rectangle(img, (int(round(x)), int(round(y))), (int(round(x + w - 1)), int(round(y + h - 1))),
-                      colour, thickness)
 
     def close(self) -> None:
         if self.writer is None and self._held is not None:
@@ -324,7 +302,7 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
             nonlocal vid
             results.append(r)
             if out is not None:
-                out.write(f.log_t, f.frame_id, r, pipe.statuses(), r.reason == INIT_REASON or r.tracking)
+                out.write(f.log_t, f.frame_id, r, pipe.statuses())
             if video is not None and f.image is not None:
                 if vid is None:
                     vid = _Video(video)
@@ -343,11 +321,11 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
             elif pipe.state == "uninitialized":    # first decodable image: initialise (as the node)
                 t0 = time.perf_counter()
                 try:
-                    pipe.init(f.image, init_box, f.stamp)
-                    init_s[0] = time.perf_counter() - t0
+                    r = pipe.init(f.image, init_box, f.stamp)
                 except ValueError as exc:
                     raise ValueError(f"--init {','.join(f'{v:g}' for v in init_box)}: {exc}") from None
-                emit(f, FrameResult(f.stamp, "tracking", box=tuple(init_box), score=1.0, reason=INIT_REASON))
+                init_s[0] = time.perf_counter() - t0
+                emit(f, r)
             else:
                 emit(f, pipe.process(f.image, f.stamp))
 

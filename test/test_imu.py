@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from iemd_ros.imu import Coverage, ImuBuffer
+from iemd_ros.imu import Coverage, ImuBuffer, SampleStatus
 from iemd_ros.rotation import GyroCalibration, integrate_rates, quat_to_rot, rotation_angle, so3_exp
 
 MS = 1_000_000
@@ -143,7 +143,8 @@ def test_nan_and_saturated_samples_are_rejected_and_counted():
     w[3] = [np.nan, 1.0, 0.0]
     w[5] = [0.0, np.inf, 0.0]
     w[7] = [0.0, np.radians(205), 0.0]
-    assert buf.add(t, w) == 7
+    A, N, S = SampleStatus.ACCEPTED, SampleStatus.NOT_FINITE, SampleStatus.SATURATED
+    assert buf.add(t, w).tolist() == [A, A, A, N, A, N, A, S, A, A]
     st = buf.stats()
     assert (st["nan"], st["saturated"], st["accepted"], st["stored"]) == (2, 1, 7, 7)
     res = buf.integrate(T0, T0 + 90 * MS)

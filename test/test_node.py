@@ -233,3 +233,33 @@ def test_malformed_input_keeps_the_node_alive_and_explains(ctx, seq):
         drv.publish_image(seq.frames[3], s[3])
         assert drv.wait_for(lambda: any(stamp_ns(d.header) == s[3] and d.detections for d in drv.detections), 10)
         assert node.context.ok() and node._worker.is_alive()
+
+
+def test_imu_wakes_the_worker_only_for_the_frame_it_holds(ctx, seq):
+    from sensor_msgs.msg import Imu
+
+    from iemd_ros.conversions import ns_to_stamp
+
+    node = TrackerNode(context=ctx, parameter_overrides=[Parameter("gyro.time_offset_ns", value=4_000_000)])
+    try:
+        wakes, notify = [], node._cond.notify_all
+        node._cond.notify_all = lambda: (wakes.append(1), notify())
+
+        def imu(t_ns):
+            msg = Imu()
+            msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(int(t_ns))
+            node._on_imu(msg)
+
+        s = [int(v) for v in seq.frame_stamps_ns]
+        node.pipeline.set_camera(seq.camera)
+        node.pipeline.init(seq.frames[0], seq.gt_boxes[0], s[0])
+        imu(s[0])
+        assert wakes == []                                    # no frame held: nobody to wake
+        with node._cond:
+            node._awaiting_imu = s[1]                         # as the worker does while it holds frame 1
+        imu(s[1])
+        assert wakes == []                                    # still short of t + time_offset
+        imu(s[1] + 4_000_000)
+        assert wakes == [1]                                   # frame 1 covered: wake the worker
+    finally:
+        node.destroy_node()

@@ -6,7 +6,7 @@ import pytest
 
 from iemd_ros.boxes import box_centre
 from iemd_ros.gyro import GyroConfig, GyroPredictor
-from iemd_ros.pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
+from iemd_ros.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
 from iemd_ros.synthetic import generate
 from iemd_ros.tracker import TrackerConfig
 
@@ -131,10 +131,24 @@ def test_imu_validation_counts_and_explains(seq):
     assert p.statuses()[2].level != ERROR
     p.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
     assert p.diagnostics()["imu_rejected"] == 13 and "covariance" in p.statuses()[2].message
-    # a clock reset (bag loop): the IMU buffer restarts
+    # a clock reset (bag loop): the IMU buffer restarts; a rejected sample stamped back there does not
+    assert not p.add_imu(t0 - 5_000_000_000, (np.nan, 0.0, 0.0))
+    assert p.diagnostics()["clock_resets"] == 0
     assert p.add_imu(t0 - 5_000_000_000, (0.0, 0.0, 0.0))
     d = p.diagnostics()
     assert d["clock_resets"] == 1 and d["imu_stored"] == 1 and "jumped back" in d["imu_reason"]
+
+
+def test_imu_before_camera_info_is_screened_and_held(seq):
+    p = _pipeline(seq, gyro={"time_offset_ns": seq.time_offset_ns, "saturation": 5.0})
+    t0 = int(seq.gyro_t_ns[0])
+    assert p.add_imu(t0, (0.0, 0.1, 0.0)) and p.add_imu(t0 + 5_000_000, (0.0, 0.1, 0.0))
+    assert not p.add_imu(t0 + 6_000_000, (np.nan, 0.0, 0.0)) and not p.add_imu(t0 + 7_000_000, (6.0, 0.0, 0.0))
+    d = p.diagnostics()
+    assert (d["imu_rejected"], d["imu_saturated"], d["imu_pending"], d["imu_stored"]) == (1, 1, 2, 2)
+    p.set_camera(seq.camera)
+    d = p.diagnostics()
+    assert (d["imu_pending"], d["imu_stored"]) == (0, 2)
 
 
 def test_frame_stamps_going_back_are_rejected_or_reset(seq):
@@ -158,7 +172,8 @@ def test_gyro_ready_and_uninitialized_state(seq):
     assert r.state == "uninitialized" and r.box is None and r.score == 0.0
     assert p.statuses()[0].level == WARN and "initial_box" in p.statuses()[0].message
     assert p.gyro_ready(s[1])                      # no target: nothing to wait for
-    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    r = p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    assert (r.stamp_ns, r.box, r.score, r.reason) == (s[0], tuple(seq.gt_boxes[0]), 1.0, INIT_REASON) and r.tracking
     _feed_imu(p, seq, upto_ns=s[1] + seq.time_offset_ns - 1)
     assert not p.gyro_ready(s[1])                  # gyro stops just before the frame
     r = p.process(seq.frames[1], s[1])
