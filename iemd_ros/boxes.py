@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["box_centre", "centre_box"]
+__all__ = ["box_centre", "centre_box", "check_box"]
 
 
 def box_centre(box) -> np.ndarray:
@@ -20,3 +20,18 @@ def centre_box(centre, size) -> np.ndarray:
     """Inverse of :func:`box_centre`: (..., 4) boxes of the given centres and ``(w, h)`` sizes."""
     c, s = np.asarray(centre, dtype=float), np.asarray(size, dtype=float)
     return np.concatenate([c - (s - 1.0) / 2.0, s], axis=-1)
+
+
+def check_box(box, what: str = "box") -> np.ndarray:
+    """``box`` as 4 floats ``(x, y, w, h)``, finite with ``w, h > 0``; else ValueError naming ``what``."""
+    try:
+        b = np.asarray(box, dtype=float).ravel()
+    except (TypeError, ValueError):
+        b = np.empty(0)
+    if b.shape != (4,):
+        raise ValueError(f"{what} must be 4 numbers (x, y, w, h), got {box!r}")
+    if not np.all(np.isfinite(b)):
+        raise ValueError(f"{what} has non-finite values: {box!r}")
+    if b[2] <= 0 or b[3] <= 0:
+        raise ValueError(f"{what} must have a positive size (w, h > 0), got {box!r}")
+    return b

@@ -17,7 +17,7 @@ from functools import lru_cache
 import numpy as np
 
 from .camera import CameraModel
-from .boxes import box_centre, centre_box
+from .boxes import box_centre, centre_box, check_box
 
 __all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "camera_model_from_info", "camera_model_from_msg",
            "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box"]
@@ -155,17 +155,13 @@ def box_to_bbox(box) -> tuple[float, float, float, float]:
     The centre is in pixel-index coordinates (pixel centres at integers, as ``K``):
     ``x + (w - 1) / 2`` (:func:`iemd_ros.boxes.box_centre`); the size is ``w, h`` pixels.
     """
-    b = np.asarray(box, dtype=float).ravel()
-    if b.shape != (4,):
-        raise ValueError(f"box must be (x, y, w, h), got {np.asarray(box).tolist()}")
+    b = check_box(box)
     cx, cy = box_centre(b)
     return float(cx), float(cy), float(b[2]), float(b[3])
 
 
 def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) -> tuple[float, float, float, float]:
     """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size."""
-    v = np.array([center_x, center_y, size_x, size_y], dtype=float)
-    if not np.all(np.isfinite(v)) or v[2] <= 0 or v[3] <= 0:
-        raise ValueError(f"bounding box needs a finite centre and a positive size, got centre ({center_x}, "
-                         f"{center_y}), size {size_x} x {size_y}")
-    return tuple(float(b) for b in centre_box(v[:2], v[2:]))
+    box = centre_box([center_x, center_y], [size_x, size_y])
+    return tuple(float(b) for b in check_box(box, f"bounding box (centre ({center_x}, {center_y}), "
+                                                  f"size {size_x} x {size_y})"))

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .boxes import centre_box
+from .boxes import centre_box, check_box
 from .camera import CameraModel
 from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
 from .rotation import GyroCalibration, StillBiasEstimator
@@ -71,16 +71,9 @@ def warp_points(points, H, camera: CameraModel | None = None) -> np.ndarray:
     return camera.distort_points(_apply_h(H, camera.undistort_points(p)))
 
 
-def _check_box(box) -> np.ndarray:
-    b = np.asarray(box, dtype=float).ravel()
-    if b.shape != (4,) or not np.all(np.isfinite(b)) or b[2] <= 0 or b[3] <= 0:
-        raise ValueError(f"box must be finite (x, y, w, h) with w, h > 0, got {np.asarray(box).tolist()}")
-    return b
-
-
 def box_grid(box) -> np.ndarray:
     """The 3x3 grid of a box's region: 4 corners (TL, TR, BR, BL), 4 edge midpoints, centre (last)."""
-    x, y, w, h = _check_box(box)
+    x, y, w, h = check_box(box)
     x, y = x - 0.5, y - 0.5
     xs, ys = [x, x + w / 2, x + w], [y, y + h / 2, y + h]
     return np.array([[xs[0], ys[0]], [xs[2], ys[0]], [xs[2], ys[2]], [xs[0], ys[2]],

@@ -22,7 +22,6 @@ never stop the node.  All tracking logic is in :class:`iemd_ros.pipeline.Trackin
 """
 from __future__ import annotations
 
-import math
 import sys
 import threading
 import time
@@ -41,6 +40,7 @@ from sensor_msgs.msg import CameraInfo, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithPose
 
+from .boxes import check_box
 from .conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_msg, image_to_array,
                           stamp_ns)
 from .drawing import draw_result
@@ -227,12 +227,7 @@ class TrackerNode(Node):
         box = list(value) if value is not None else []
         if not box:
             return None
-        if len(box) != 4:
-            raise ValueError(f"initial_box must be [] or [x, y, w, h], got {box}")
-        x, y, w, h = (float(b) for b in box)
-        if not all(math.isfinite(c) for c in (x, y, w, h)) or w <= 0 or h <= 0:
-            raise ValueError(f"initial_box needs finite values and w, h > 0, got {box}")
-        return (x, y, w, h)
+        return tuple(float(v) for v in check_box(box, "initial_box ([] for none)"))
 
     def _on_set_parameters(self, params) -> SetParametersResult:
         changes = {p.name: p.value for p in params}

@@ -51,6 +51,7 @@ from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Pro
                      iter_messages, open_bag, select_topics)
 from .camera import CameraModel
 from .cli import CliParser, cli_main
+from .boxes import check_box
 from .conversions import box_to_bbox, camera_model_from_msg, image_to_array, stamp_ns
 from .drawing import draw_result
 from .pipeline import INIT_REASON, FrameResult, PipelineConfig, TrackingPipeline
@@ -109,16 +110,12 @@ class ReplayResult:
 
 
 def parse_box(text: str) -> tuple[float, float, float, float]:
-    """``"X,Y,W,H"`` -> 4 floats (w, h > 0); ValueError otherwise."""
+    """``"X,Y,W,H"`` -> 4 floats (finite, w, h > 0); ValueError otherwise."""
     try:
         vals = [float(v) for v in str(text).split(",")]
     except ValueError:
         raise ValueError(f"--init must be X,Y,W,H (4 numbers), got {text!r}") from None
-    if len(vals) != 4 or not all(math.isfinite(v) for v in vals):
-        raise ValueError(f"--init must be X,Y,W,H (4 finite numbers), got {text!r}")
-    if vals[2] <= 0 or vals[3] <= 0:
-        raise ValueError(f"--init box needs W, H > 0, got {text!r}")
-    return tuple(vals)
+    return tuple(float(v) for v in check_box(vals, "--init"))
 
 
 def load_gt(path) -> np.ndarray:

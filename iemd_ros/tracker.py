@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass, fields
 import numpy as np
 
 from .appearance import ImagePyramid, PatchLayout, to_gray
-from .boxes import box_centre, centre_box
+from .boxes import box_centre, centre_box, check_box
 from .candidate import CandidateModel, TargetModel
 from .sparse_coding import max_alignment_pooling
 from .template import TemplateDictionary
@@ -431,14 +431,7 @@ def _check_frame(frame) -> None:
 
 
 def _check_box(box, shape):
-    try:
-        x, y, w, h = (float(v) for v in box)
-    except (TypeError, ValueError):
-        raise ValueError(f"box must be 4 numbers (x, y, w, h), got {box!r}") from None
-    if not all(np.isfinite([x, y, w, h])):
-        raise ValueError(f"box has non-finite values: {box!r}")
-    if w <= 0 or h <= 0:
-        raise ValueError(f"box must have positive size, got w={w}, h={h}")
+    x, y, w, h = (float(v) for v in check_box(box))
     if x + w <= 0 or y + h <= 0 or x >= shape[1] or y >= shape[0]:
         raise ValueError(f"box {box!r} lies outside the {shape[1]}x{shape[0]} image")
     return x, y, w, h

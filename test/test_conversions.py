@@ -4,7 +4,7 @@ import array
 import numpy as np
 import pytest
 
-from iemd_ros.boxes import box_centre, centre_box
+from iemd_ros.boxes import box_centre, centre_box, check_box
 from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info,
                                   image_to_array, ns_to_stamp, stamp_to_ns)
 
@@ -112,3 +112,16 @@ def test_box_centre_and_centre_box_are_inverse():
     boxes = np.array([[10, 20, 4, 6], [-0.5, 3.25, 7, 1]])
     np.testing.assert_array_equal(box_centre(boxes), [[11.5, 22.5], [2.5, 3.25]])
     np.testing.assert_array_equal(centre_box(box_centre(boxes), boxes[:, 2:]), boxes)
+
+
+@pytest.mark.parametrize("box,message", [
+    ((1, 2, 3), "marker must be 4 numbers (x, y, w, h), got (1, 2, 3)"),
+    ("abcd", "marker must be 4 numbers (x, y, w, h), got 'abcd'"),
+    ((1, float("inf"), 3, 4), "marker has non-finite values: (1, inf, 3, 4)"),
+    ((1, 2, 0, 4), "marker must have a positive size (w, h > 0), got (1, 2, 0, 4)"),
+])
+def test_check_box_names_what_is_wrong(box, message):
+    with pytest.raises(ValueError) as exc:
+        check_box(box, "marker")
+    assert str(exc.value) == message
+    np.testing.assert_array_equal(check_box([1, 2, 3, 4]), [1.0, 2.0, 3.0, 4.0])

@@ -178,7 +178,7 @@ def test_parameters_are_validated_with_reasons(ctx):
             "tracker.lam": (1, "Wrong parameter type"),                  # integer for a double
             "gyro.R_cam_imu": ([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0], "proper 3x3 rotation"),
             "gyro.bias": ([0.0, 0.0], "3 finite values"),
-            "initial_box": ([1.0, 2.0], "[x, y, w, h]"),
+            "initial_box": ([1.0, 2.0], "initial_box ([] for none) must be 4 numbers"),
             "reliable_qos": (False, "read-only"),
         }
         for name, (value, reason) in cases.items():

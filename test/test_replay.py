@@ -197,8 +197,8 @@ def test_bad_input(seq, bags, tmp_path, capsys):
         ([str(bags / "shaky"), "--init", init, "--imu-topic", DEFAULT_TOPICS["image"]], "expected sensor_msgs/msg/Imu"),
         ([str(bags / "shaky"), "--init", init, "--camera-info-topic", "/nope"], "is not in the bag"),
         ([str(bags / "shaky"), "--init", "400,10,20,20"], "outside the 320x240 image"),
-        ([str(bags / "shaky"), "--init", "10,10,0,20"], "W, H > 0"),
-        ([str(bags / "shaky"), "--init", "10,10,20"], "X,Y,W,H"),
+        ([str(bags / "shaky"), "--init", "10,10,0,20"], "positive size"),
+        ([str(bags / "shaky"), "--init", "10,10,20"], "--init must be 4 numbers"),
         ([str(bags / "shaky"), "--init", init, "--gt", str(tmp_path / "none.txt")], "cannot read ground truth"),
     ]
     for argv, text in cases:
