@@ -11,8 +11,12 @@ For every ``stride``-th frame k, with the target model of frame 1 (no template u
   resampled to the template size.  This is what a perfect search could reach with the model.
 * one step: the tracker started from the ground truth of frame k - ``jump`` and updated on frame k
   (IoU with the ground truth of k), against staying at the start.
+* capture range (``--capture``): on 6 frames per sequence, a tracker initialized on that frame (an
+  exact model) searches the same frame from starts 0.05-0.4 window sizes away from the target in 8
+  directions (coarse-to-fine descent, no particles or scale search); the share of starts that end
+  within 0.05 window sizes of it.
 
-All numbers are mean IoU in %.
+All other numbers are mean IoU in %.
 """
 from __future__ import annotations
 
@@ -28,6 +32,7 @@ from iemd_ros.metrics import iou
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
 OFFSETS = np.linspace(-0.6, 0.6, 13)
+CAPTURE_STARTS = (0.05, 0.1, 0.2, 0.3, 0.4)
 SEQUENCES = "Bolt2,Car4,Couple,David,Deer,DragonBaby,Freeman1,Jogging-1,Jogging-2,MotorRolling,Skiing,Woman"
 
 
@@ -71,12 +76,31 @@ def measure(job):
     return name, 100.0 * np.mean(rows, axis=0)
 
 
+def capture(name):
+    """Per start distance in CAPTURE_STARTS, the share of searches that end within 0.05 window sizes."""
+    seq = load_sequence(name, default_root())
+    converged, searches = np.zeros(len(CAPTURE_STARTS)), 0
+    for k in np.linspace(0, len(seq) - 1, 6).astype(int):
+        frame, truth = read_frame(seq.frame_paths[k]), np.asarray(seq.gt_boxes[k], dtype=float)
+        tracker = IemdTracker(TrackerConfig(n_particles=0, scale_step=0.0, update_templates=False))
+        tracker.init(frame, truth)
+        pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(truth), truth[2:]
+        for angle in np.linspace(0, 2 * np.pi, 8, endpoint=False):
+            direction = np.array([np.cos(angle), np.sin(angle)])
+            for i, distance in enumerate(CAPTURE_STARTS):
+                end = tracker._search(pyramid, centre + distance * size * direction, size).center
+                converged[i] += np.linalg.norm((end - centre) / size) < 0.05
+            searches += 1
+    return name, 100.0 * converged / searches
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sequences", default=SEQUENCES)
     parser.add_argument("--stride", type=int, default=10)
     parser.add_argument("--jump", type=int, default=3)
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--capture", action="store_true", help="also measure the descent's capture range")
     args = parser.parse_args()
     jobs = [(name, args.stride, args.jump) for name in args.sequences.split(",")]
     with Pool(args.jobs) as pool:
@@ -86,6 +110,13 @@ def main():
         print(f"{name:14s} {values[0]:9.1f} {values[1]:9.1f} {values[2]:10.1f} {values[3]:6.1f}")
     mean = np.mean([values for _, values in results], axis=0)
     print(f"{'mean':14s} {mean[0]:9.1f} {mean[1]:9.1f} {mean[2]:10.1f} {mean[3]:6.1f}")
+    if args.capture:
+        with Pool(args.jobs) as pool:
+            shares = pool.map(capture, args.sequences.split(","))
+        print("\ncapture range: % of searches ending within 0.05 window sizes, by start distance (window sizes)")
+        print(f"{'sequence':14s} " + " ".join(f"{d:>6}" for d in CAPTURE_STARTS))
+        for name, share in shares + [("mean", np.mean([v for _, v in shares], axis=0))]:
+            print(f"{name:14s} " + " ".join(f"{v:6.0f}" for v in share))
 
 
 if __name__ == "__main__":
