@@ -242,9 +242,9 @@ class GyroPredictor:
         """Add raw gyro samples (IMU frame, rad/s, stamps in ns on the IMU clock); returns their
         :class:`~iemd_ros.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
         status = self.buffer.add(t_ns, w)
-        good = status == SampleStatus.ACCEPTED
-        if not self.bias_estimator.done and good.any():
-            if self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
+        if not self.bias_estimator.done:
+            good = status == int(SampleStatus.ACCEPTED)
+            if good.any() and self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
         return status
 

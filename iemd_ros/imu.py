@@ -48,6 +48,11 @@ class SampleStatus(IntEnum):
     SATURATED = 2                            # |w_i| >= saturation: rejected
 
 
+# The statuses as plain ints for the array code: numpy comparing an array with an IntEnum member
+# probes the enum class for array attributes, which doubled the cost of adding one IMU sample.
+_ACCEPTED, _NOT_FINITE, _SATURATED = (int(s) for s in SampleStatus)
+
+
 @dataclass(frozen=True)
 class ImuIntegration:
     """Result of integrating the gyro over one frame interval.
@@ -142,12 +147,14 @@ class ImuBuffer:
                 raise ValueError("gyro stamps must be integer nanoseconds")
         t = t.astype(np.int64)
         status = self._screen(w)
-        keep = status == SampleStatus.ACCEPTED
+        keep = status == _ACCEPTED
         with self._lock:
             c = self.counts
             c["added"] += len(t)
-            c["nan"] += int((status == SampleStatus.NOT_FINITE).sum())
-            c["saturated"] += int((status == SampleStatus.SATURATED).sum())
+            if not keep.all():
+                per_status = np.bincount(status, minlength=3)
+                c["nan"] += int(per_status[_NOT_FINITE])
+                c["saturated"] += int(per_status[_SATURATED])
             t, w = t[keep], w[keep]
             if len(t) == 0:
                 return status
@@ -168,10 +175,10 @@ class ImuBuffer:
     def _screen(self, w: np.ndarray) -> np.ndarray:
         """:class:`SampleStatus` of (N, 3) rates: NaN/inf rejected, then ``|w_i| >= saturation``."""
         finite = np.isfinite(w).all(axis=1)
-        status = np.where(finite, SampleStatus.ACCEPTED, SampleStatus.NOT_FINITE).astype(np.int8)
+        status = np.where(finite, _ACCEPTED, _NOT_FINITE).astype(np.int8)
         if self.saturation is not None:
             over = (np.abs(np.where(finite[:, None], w, 0.0)) >= self.saturation).any(axis=1)
-            status[over] = SampleStatus.SATURATED
+            status[over] = _SATURATED
         return status
 
     def _merge(self) -> None:

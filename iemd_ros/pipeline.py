@@ -300,7 +300,7 @@ class TrackingPipeline:
             c = self.counters
             c["imu_received"] += 1
             newest = self._predictor.buffer.t_newest_ns
-            status = self._predictor.add_imu(t, w)[0]
+            status = int(self._predictor.add_imu(t, w)[0])
             if status == SampleStatus.NOT_FINITE:
                 return self._reject_imu("imu_rejected", f"IMU sample at {t} ns rejected: angular velocity "
                                                         f"{w.tolist()} is not 3 finite values")
