@@ -281,3 +281,13 @@ class GyroPredictor:
         except ValueError as exc:       # box far outside the lens model's valid region
             return GyroPrediction(integ, integ.R, H, None, None, f"no gyro prior at this box: {exc}")
         return GyroPrediction(integ, integ.R, H, prior, pbox, integ.reason, res)
+
+
+def compile_gyro_jit() -> None:
+    """JIT-compile the gyro path's numba kernels now (or load them from numba's on-disk cache):
+    the window integration and the lens undistortion.  In a fresh environment the first gyro
+    prediction otherwise stalls for ~2 s; a node or a replay calls this at start-up (with
+    :func:`iemd_ros.tracker.compile_jit`)."""
+    predictor = GyroPredictor(CameraModel(np.diag([100.0, 100.0, 1.0]), [0.1, 0.0, 0.0, 0.0, 0.0], 64, 48))
+    predictor.add_imu(np.array([0, 10_000_000, 20_000_000]), np.full((3, 3), 0.1))
+    predictor.predict(2_000_000, 12_000_000, (16.0, 16.0, 16.0, 16.0))

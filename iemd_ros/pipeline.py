@@ -37,7 +37,7 @@ from dataclasses import asdict, dataclass, field, fields
 import numpy as np
 
 from .camera import CameraModel
-from .gyro import GyroConfig, GyroPredictor
+from .gyro import GyroConfig, GyroPredictor, compile_gyro_jit
 from .imu import SampleStatus
 from .tracker import IemdTracker, TrackerConfig, compile_jit
 
@@ -193,7 +193,8 @@ class TrackingPipeline:
     """Tracker + gyro predictor fed message by message (see the module docstring)."""
 
     def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
-        compile_jit()  # the tracker's JIT: at start-up, not on the first frame
+        compile_jit()  # the tracker's and the gyro's JIT: at start-up, not on the first frames
+        compile_gyro_jit()
         self._cfg = config if config is not None else PipelineConfig()
         if not isinstance(self._cfg, PipelineConfig):
             raise ValueError("config must be a PipelineConfig")
