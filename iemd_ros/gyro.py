@@ -96,7 +96,7 @@ def predict_box(box, H, camera: CameraModel | None = None) -> np.ndarray:
     The centre is the exact image of the box centre; the width/height are the mean lengths of the
     mapped top/bottom and left/right edges (so a camera roll moves but does not inflate the box).
     """
-    return _prior_and_box(box, H, camera)[2]
+    return _box_from_grid(_warp_grid(box, box_grid(box), H, camera))
 
 
 def _prior_and_box(box, H, camera):

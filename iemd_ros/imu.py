@@ -23,7 +23,7 @@ from enum import Enum, IntEnum
 import numba
 import numpy as np
 
-from .rotation import GyroCalibration, magnus_product, quat_to_rot, rot_to_quat
+from .rotation import GyroCalibration, magnus_product, quat_to_rot
 
 __all__ = ["Coverage", "SampleStatus", "ImuIntegration", "ImuBuffer"]
 
@@ -69,11 +69,6 @@ class ImuIntegration:
     t0_ns: int
     t1_ns: int
     max_gap_ns: int = 0
-
-    @property
-    def q(self) -> np.ndarray:
-        """``R`` as a unit quaternion (w, x, y, z), computed on demand (nothing on the frame path needs it)."""
-        return rot_to_quat(self.R)
 
     @property
     def covered(self) -> bool:
@@ -269,7 +264,7 @@ class ImuBuffer:
         if t1 == t0:
             return _identity(t0, t1, Coverage.OK, "empty window", n_used, max_gap)
         # knots: t0, the samples strictly inside, t1 (rates interpolated at the ends)
-        q_imu = _window_rotation((ts - t0).astype(float) * 1e-9, np.ascontiguousarray(ws), (t1 - t0) * 1e-9,
+        q_imu = _window_rotation((ts - t0).astype(float) * 1e-9, ws, (t1 - t0) * 1e-9,
                                  coning)
         R = cal.R_cam_imu @ quat_to_rot(q_imu) @ cal.R_cam_imu.T
         if max_gap > self.max_gap_ns:
