@@ -43,7 +43,7 @@ def main():
                 tracker = IemdTracker(TrackerConfig(gradient=gradient))
                 tracker.init(prev, seq.gt_boxes[k - 1])
                 for offset in offsets:
-                    state = tracker._descend(pyramid, truth + offset, size)
+                    state = tracker._descend(pyramid, tracker._candidate(pyramid, truth + offset, size))
                     errors[gradient].append(np.linalg.norm(state.center - truth))
                     iterations[gradient].append(state.iterations)
     print(f"starts up to {args.offset} px from the ground truth, {len(errors['paper'])} per gradient")

@@ -62,6 +62,7 @@ class CandidateModel:
         """
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
+        self.coarse = coarse  # pyramid levels above the anti-aliasing level it was sampled at
         self.target = target
         self.alpha = alpha
         self.bandwidth = bandwidth
@@ -98,8 +99,10 @@ class CandidateModel:
 
     def emd(self, y=(0.0, 0.0)):
         """(EMD, EmdSolution) between the target and the kernel centred at offset ``y``; (inf, None)
-        when no bin has weight.  The solution is kept for :meth:`gradient`."""
+        when no bin has weight.  The solution is kept for :meth:`gradient` (and reused at the same ``y``)."""
         y = np.asarray(y, dtype=np.float64)
+        if self._solved is not None and np.array_equal(self._solved[0], y):
+            return self._solved[3].value, self._solved[3]
         w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, self.bandwidth)
         keep = np.flatnonzero(w_c > 0)
         if keep.size == 0:

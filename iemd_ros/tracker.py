@@ -268,9 +268,9 @@ class IemdTracker:
         off 34.9 % (it helps the panning Bolt2 and Woman, hurts the large Car4).
         """
         if not self.config.coarse_to_fine:
-            return self._descend(pyramid, center, size)
-        coarse = self._descend(pyramid, center, size, coarse=True)
-        fine = self._descend(pyramid, coarse.center, size)
+            return self._descend(pyramid, self._candidate(pyramid, center, size))
+        coarse = self._descend(pyramid, self._candidate(pyramid, center, size, coarse=True))
+        fine = self._descend(pyramid, self._candidate(pyramid, coarse.center, size))
         fine.warnings += coarse.warnings
         return fine
 
@@ -285,27 +285,25 @@ class IemdTracker:
         scored, warnings = [], 0
         for start in starts:
             if self.config.coarse_to_fine:
-                coarse = self._descend(pyramid, start, size, coarse=True)
+                coarse = self._descend(pyramid, self._candidate(pyramid, start, size, coarse=True))
                 start, warnings = coarse.center, warnings + coarse.warnings
             model = self._candidate(pyramid, start, size)
             emd, solution = model.emd()
             warnings += int(solution is not None and not solution.optimal)
             scored.append((emd, model))
-        best = self._descend(pyramid, None, size, start=min(scored, key=lambda item: item[0])[1])
+        best = self._descend(pyramid, min(scored, key=lambda item: item[0])[1])
         best.codings += len(scored) - 1  # the winner's model is the descent's first
         best.warnings += warnings
         return best
 
-    def _descend(self, pyramid: ImagePyramid, center, size, coarse: bool = False,
-                 start: CandidateModel | None = None) -> _Descent:
-        """Algorithm 1 from one start: move against dEMD/dy while the EMD decreases.
+    def _descend(self, pyramid: ImagePyramid, model: CandidateModel) -> _Descent:
+        """Algorithm 1 from the window of ``model``: move against dEMD/dy while the EMD decreases.
 
         The paper moves one pixel along the gradient and stops at the first EMD
         increase.  We start with ``step_px`` and halve the step on an increase,
         stopping below ``min_step_px``: the same stopping rule (the EMD no longer
         decreases, at the finest step), but it reaches sub-pixel positions and
-        covers larger motions in fewer EMD solves.  ``start``: a model already
-        built at the starting window (then ``center`` is not used).
+        covers larger motions in fewer EMD solves.
 
         Capture range (benchmarks/model_ceiling.py --capture, exact model, 12 OTB
         sequences): starts 0.05 / 0.1 / 0.2 / 0.4 window sizes off end on the
@@ -317,11 +315,11 @@ class IemdTracker:
         reaches distractors) and updates took 3x longer, so it was not kept.
         """
         cfg = self.config
-        half = np.asarray(size, dtype=np.float64) / 2.0
+        size, coarse = model.size, bool(model.coarse)
+        half = size / 2.0
         c, s = np.cos(self._search_angle), np.sin(self._search_angle)
         axes = np.array([[c, -s], [s, c]])  # window axes -> image axes
-        model = start if start is not None else self._candidate(pyramid, center, size, coarse)
-        emd, grad, sol = model.evaluate(cfg.gradient)
+        emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
         state = _Descent(center=model.center, emd=emd,
                          warnings=int(sol is not None and not sol.optimal))
         # The coarse stage samples one pyramid level up: its steps are twice as long.
