@@ -138,6 +138,8 @@ class PatchLayout:
         treated as constant (they change far more slowly than the pixels).
         """
         template = np.asarray(template, dtype=np.float64)
+        if template.shape != self.template_size[::-1]:
+            raise ValueError(f"template of shape {template.shape} does not match {self.template_size[::-1]}")
         pw, ph = self.patch_size
         if self.normalization == "window":
             scale = 1.0 / (max(template.std(), self.min_contrast) * np.sqrt(pw * ph))
@@ -150,8 +152,6 @@ class PatchLayout:
             center, floor = True, self.min_contrast * np.sqrt(pw * ph)
         else:
             center, floor = False, 1e-6
-        if template.shape != self.template_size[::-1]:
-            raise ValueError(f"template of shape {template.shape} does not match {self.template_size[::-1]}")
         gx, gy = _gradient(template) if jacobian else (template, template)
         eps, jac = _unit_patches(template.ravel(), gx.ravel(), gy.ravel(), self._patch_index, center, floor,
                                  jacobian)
@@ -160,7 +160,7 @@ class PatchLayout:
     @cached_property
     def _patch_index(self) -> np.ndarray:
         """(N, m*n) flat template indices of each patch's pixels, row-major patches."""
-        tw, th = self.template_size
+        tw = self.template_size[0]
         pw, ph = self.patch_size
         nx, ny = self.cells
         corners = (np.arange(ny)[:, None] * self.step * tw + np.arange(nx)[None, :] * self.step).ravel()
@@ -168,9 +168,7 @@ class PatchLayout:
         return corners[:, None] + offsets[None, :]
 
     def _patches(self, image: np.ndarray) -> np.ndarray:
-        if image.shape != self.template_size[::-1]:
-            raise ValueError(f"template of shape {image.shape} does not match {self.template_size[::-1]}")
-        return np.asarray(image, dtype=np.float64).ravel()[self._patch_index]
+        return image.ravel()[self._patch_index]
 
 
 @numba.njit(cache=True)

@@ -35,7 +35,7 @@ class TrackerConfig:
     n_iter: int = 20  # maximum descent iterations per start
     step_px: float = 2.0  # first step along the descent direction, image pixels
     min_step_px: float = 0.5  # stop when backtracking has halved the step below this
-    gradient: str = "appearance"  # "appearance", "envelope" or "paper" (eq. 10): see CandidateModel.evaluate
+    gradient: str = "appearance"  # "appearance", "envelope" or "paper" (eq. 10): see CandidateModel.gradient
     coarse_to_fine: bool = True  # first descend on the next pyramid level (wider convergence region)
     scale_step: float = 0.02  # relative scale variants tried at the converged position
     scale_range: float = 0.02  # largest scale change per frame, in scale_step steps (paper's gyro run: 0.1)

@@ -18,7 +18,7 @@ from sensor_msgs.msg import CameraInfo, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray
 
-from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp, stamp_ns  # noqa: F401  (stamp_ns: also for the tests)
+from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp
 
 FRAME_ID = "synthetic_cam"
 

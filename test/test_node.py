@@ -11,11 +11,11 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
-from ros_harness import FRAME_ID, Driver, level, spinning, stamp_ns, values  # noqa: E402
+from ros_harness import FRAME_ID, Driver, level, spinning, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
 
-from iemd_ros.conversions import image_to_array  # noqa: E402
+from iemd_ros.conversions import image_to_array, stamp_ns  # noqa: E402
 from iemd_ros.boxes import box_centre  # noqa: E402
 from iemd_ros.node import TrackerNode  # noqa: E402
 from iemd_ros.synthetic import generate  # noqa: E402
