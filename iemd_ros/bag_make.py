@@ -47,7 +47,8 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from .bag_io import CAMERA_INFO_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX, BagWriter, camera_info_fields, header
+from .bag_io import (CAMERA_INFO_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX, BagWriter, Progress,
+                     camera_info_fields, header)
 from .camera import CameraModel
 from .cli import CliParser, cli_main
 from .otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
@@ -353,8 +354,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     def body() -> int:
-        from .bag_io import Progress
-
         a = build_parser().parse_args(argv)
         src = source_from_folder(a.source, a.fps, a.stamps, a.imu_csv, a.camera_yaml, a.time_offset_ms,
                                  a.imu_frame_id)

@@ -22,7 +22,7 @@ def centre_box(centre, size) -> np.ndarray:
     return np.concatenate([c - (s - 1.0) / 2.0, s], axis=-1)
 
 
-def check_box(box, what: str = "box") -> np.ndarray:
+def check_box(box, what: str = "box") -> tuple[float, float, float, float]:
     """``box`` as 4 floats ``(x, y, w, h)``, finite with ``w, h > 0``; else ValueError naming ``what``."""
     try:
         b = np.asarray(box, dtype=float).ravel()
@@ -34,4 +34,4 @@ def check_box(box, what: str = "box") -> np.ndarray:
         raise ValueError(f"{what} has non-finite values: {box!r}")
     if b[2] <= 0 or b[3] <= 0:
         raise ValueError(f"{what} must have a positive size (w, h > 0), got {box!r}")
-    return b
+    return tuple(float(v) for v in b)

@@ -157,11 +157,10 @@ def box_to_bbox(box) -> tuple[float, float, float, float]:
     """
     b = check_box(box)
     cx, cy = box_centre(b)
-    return float(cx), float(cy), float(b[2]), float(b[3])
+    return float(cx), float(cy), b[2], b[3]
 
 
 def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) -> tuple[float, float, float, float]:
     """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size."""
     box = centre_box([center_x, center_y], [size_x, size_y])
-    return tuple(float(b) for b in check_box(box, f"bounding box (centre ({center_x}, {center_y}), "
-                                                  f"size {size_x} x {size_y})"))
+    return check_box(box, f"bounding box (centre ({center_x}, {center_y}), size {size_x} x {size_y})")

@@ -227,7 +227,7 @@ class TrackerNode(Node):
         box = list(value) if value is not None else []
         if not box:
             return None
-        return tuple(float(v) for v in check_box(box, "initial_box ([] for none)"))
+        return check_box(box, "initial_box ([] for none)")
 
     def _on_set_parameters(self, params) -> SetParametersResult:
         changes = {p.name: p.value for p in params}

@@ -14,9 +14,9 @@ IMU synchronization: a frame is held until the gyro covers it (:meth:`TrackingPi
 or until ``imu_wait_ms`` (pipeline config, default 15 ms) of *bag* time has passed after it (a message
 logged later than that is applied after the frame), then processed (without the prior if the gyro
 still does not cover it).  As in the node, an Imu with ``angular_velocity_covariance[0] = -1`` carries no
-rate and is rejected.  This is what the node does with
-the bag played at 1x when its processing keeps up (the node waits ``imu_wait_ms`` of wall time); the
-live node may in addition drop frames that arrive while it is busy, the offline replay never drops.
+rate and is rejected.  This is what the node does with the bag played at 1x when its processing keeps
+up (the node waits ``imu_wait_ms`` of wall time); the live node may in addition drop frames that
+arrive while it is busy, the offline replay never drops.
 The gyro time offset ``t_d`` is ``gyro.time_offset_ns`` of the config (default 0: bags made by
 ``iemd-make-bag`` already carry IMU stamps on the camera clock).
 
@@ -45,13 +45,14 @@ from collections import deque
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
+import cv2
 import numpy as np
 
 from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Progress, Topics, deserialize, header,
                      iter_messages, open_bag, select_topics)
+from .boxes import check_box
 from .camera import CameraModel
 from .cli import CliParser, cli_main
-from .boxes import check_box
 from .conversions import box_to_bbox, camera_model_from_msg, image_to_array, stamp_ns
 from .drawing import draw_result
 from .pipeline import INIT_REASON, FrameResult, PipelineConfig, TrackingPipeline
@@ -111,11 +112,7 @@ class ReplayResult:
 
 def parse_box(text: str) -> tuple[float, float, float, float]:
     """``"X,Y,W,H"`` -> 4 floats (finite, w, h > 0); ValueError otherwise."""
-    try:
-        vals = [float(v) for v in str(text).split(",")]
-    except ValueError:
-        raise ValueError(f"--init must be X,Y,W,H (4 numbers), got {text!r}") from None
-    return tuple(float(v) for v in check_box(vals, "--init"))
+    return check_box(str(text).split(","), "--init")
 
 
 def load_gt(path) -> np.ndarray:
@@ -213,8 +210,6 @@ class _Video:
         self.writer.write(img)
 
     def _open(self, shape, fps: float) -> None:
-        import cv2
-
         self.path.parent.mkdir(parents=True, exist_ok=True)
         h, w = shape[:2]
         self.writer = cv2.VideoWriter(str(self.path), cv2.VideoWriter_fourcc(*"mp4v"),
@@ -254,7 +249,7 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
     on bad input; partial output files are removed then.
     """
     warn = warn if warn is not None else (lambda s: print(f"iemd-replay: warning: {s}", file=sys.stderr))
-    init_box = parse_box(",".join(map(str, init_box))) if not isinstance(init_box, str) else parse_box(init_box)
+    init_box = parse_box(init_box) if isinstance(init_box, str) else check_box(init_box, "--init")
     cfg = config if config is not None else PipelineConfig()
     warnings: list[str] = []
 

@@ -438,7 +438,7 @@ def _check_frame(frame) -> None:
 
 
 def _check_box(box, shape):
-    x, y, w, h = (float(v) for v in check_box(box))
+    x, y, w, h = check_box(box)
     if x + w <= 0 or y + h <= 0 or x >= shape[1] or y >= shape[0]:
         raise ValueError(f"box {box!r} lies outside the {shape[1]}x{shape[0]} image")
     return x, y, w, h
