@@ -4,6 +4,18 @@ Bin r carries the pooled code weight ``p_r`` (or ``q_r``) of patch r and the
 Epanechnikov profile ``k(x) = max(0, 1 - x)`` of its squared normalized distance
 to the window centre, ``x = ||(c_r - y) / h||^2``.
 
+Reading of section 4 (its index u of ``p_ru`` is ambiguous): every patch is a
+bin, with its own appearance and position in the ground distance.  The other
+reading, K bins at the dictionary's patch positions, each densely sampled patch
+voting ``||a_bar_r||_inf`` into the bin of its largest pooled code, needs that
+largest code to name where the patch sits in the target.  Measured
+(benchmarks/vote_histogram.py, 12 OTB sequences, frame-1 dictionary, frames
+10-90): on frame 1 itself 60.9 % of the step-2 patches vote within one patch
+step of their place, on later frames 27.6 %; the lowest EMD on a +-0.4 window
+grid lies 0.230 window sizes from the truth against 0.197 for per-patch bins.
+A prototype tracker on the votes (kernel moving over fixed dense patches, not
+kept) scored 6-14 % average overlap on Car4/Bolt2/Woman.
+
 Bandwidth choice (the paper only says "h is template size"): positions are in
 normalized window units (the window is [-1, 1]^2).  The tracker's default is
 h = 1, the ellipse inscribed in the window (the corner patches of the

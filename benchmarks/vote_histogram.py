@@ -1,0 +1,129 @@
+#!/usr/bin/env python3
+"""The paper's other reading of the sparse-coding histogram, measured against the tracker's.
+
+    python benchmarks/vote_histogram.py [--sequences Car4,Bolt2,Woman] [--frames 100] [--stride 10]
+
+Section 4 can be read two ways.
+
+(a) The tracker's (iemd_ros.candidate): every local patch r is a bin; its mass is its pooled code
+    weight ||a_bar_r||_inf times the kernel, and its appearance eps_r and position c_r enter the
+    ground distance.
+(b) A vote histogram: the K bins are the dictionary's patch positions; every densely sampled patch r
+    puts its weight ||a_bar_r||_inf into the bin u = argmax_j a_bar_rj of its largest pooled code
+    (w_T,u = gamma sum_r k(c_r) |p_ru|), and the ground distance is taken between the dictionary
+    atoms and their positions, so it does not depend on the window.
+
+(b) can only localize if a patch's largest code names the place in the target it came from.  For
+every ``stride``-th frame k of the first ``frames`` (target model and dictionary of frame 1, as the
+tracker builds them; window at the ground truth of frame k), this prints:
+
+* votes: the share of dense (step 2) patches inside the kernel whose largest code is an atom
+  within one patch step (0.3 half-widths) of their own position;
+* argmin: the distance in window sizes from the ground truth to the window with the lowest EMD on a
+  9 x 9 grid of offsets within +-0.4 window sizes, for (a) and (b).  0 means that the EMD singles out
+  the target.
+"""
+from __future__ import annotations
+
+import argparse
+from multiprocessing import Pool
+
+import numpy as np
+
+from iemd_ros import IemdTracker
+from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
+from iemd_ros.boxes import box_centre
+from iemd_ros.emd import ground_distance, solve_emd
+from iemd_ros.histogram import candidate_weights
+from iemd_ros.otb import default_root, load_sequence, read_frame
+
+OFFSETS = np.linspace(-0.4, 0.4, 9)
+DENSE_STEP = 2
+NEAR = 0.3  # one patch step of the 8x8 / step-4 layout is 0.25 half-widths
+
+
+class VoteHistogram:
+    """Reading (b) on the tracker's frame-1 dictionary (atoms = the patches of I_0's layout)."""
+
+    def __init__(self, tracker: IemdTracker):
+        cfg = tracker.config
+        self.tracker = tracker
+        self.coder = tracker.dictionary.coder
+        self.bin_pos = tracker.layout.positions()
+        atoms = self.coder.dictionary.T
+        self.cost = ground_distance(atoms, self.bin_pos, atoms, self.bin_pos, cfg.alpha)
+        self.dense = PatchLayout(cfg.template_size, cfg.patch_size, DENSE_STEP, cfg.normalization)
+        self.w_t = self.histogram(tracker.dictionary.templates[0])
+
+    def votes(self, template):
+        """(bin, weight) of every dense patch of ``template``: the argmax atom and ||a_bar||_inf."""
+        codes = self.coder.encode(self.dense.extract(template).T)
+        return codes.argmax(axis=0), codes.max(axis=0)
+
+    def histogram(self, template) -> np.ndarray:
+        bins, weights = self.votes(template)
+        w, _ = candidate_weights(weights, self.dense.positions(), np.zeros(2), self.tracker.config.kernel_bandwidth)
+        return np.bincount(bins, w, minlength=len(self.bin_pos))
+
+    def emd(self, template) -> float:
+        w_c = self.histogram(template)
+        kt, kc = np.flatnonzero(self.w_t > 0), np.flatnonzero(w_c > 0)
+        if kc.size == 0:
+            return np.inf
+        return solve_emd(self.w_t[kt], w_c[kc], self.cost[np.ix_(kt, kc)]).value
+
+    def vote_accuracy(self, template) -> float:
+        bins, _ = self.votes(template)
+        pos = self.dense.positions()
+        inside = (pos**2).sum(axis=1) < self.tracker.config.kernel_bandwidth**2
+        near = np.linalg.norm(self.bin_pos[bins] - pos, axis=1) < NEAR
+        return float(near[inside].mean())
+
+
+def _argmin_distance(score, center, size) -> float:
+    """Distance (window sizes) from the centre to the lowest score on the offset grid."""
+    grid = [(dx, dy) for dy in OFFSETS for dx in OFFSETS]
+    values = [score(center + np.array(off) * size) for off in grid]
+    return float(np.hypot(*grid[int(np.argmin(values))]))
+
+
+def measure(job):
+    name, frames, stride = job
+    seq = load_sequence(name, default_root())
+    tracker = IemdTracker()
+    tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
+    votes = VoteHistogram(tracker)
+    tsize = tracker.config.template_size
+    rows = []
+    for k in range(stride, min(frames, len(seq)), stride):
+        pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
+        center, size = box_centre(seq.gt_boxes[k]), tracker._size
+        accuracy = votes.vote_accuracy(pyramid.sample(center, size, tsize))
+        patch_bins = _argmin_distance(lambda c: tracker._candidate(pyramid, c, size).emd()[0], center, size)
+        vote_bins = _argmin_distance(lambda c: votes.emd(pyramid.sample(c, size, tsize)), center, size)
+        rows.append((accuracy, patch_bins, vote_bins))
+    frame0 = votes.vote_accuracy(tracker.dictionary.templates[0])
+    return name, frame0, np.array(rows)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sequences", default="Car4,Bolt2,Woman")
+    parser.add_argument("--frames", type=int, default=100, help="frames 1..N of each sequence")
+    parser.add_argument("--stride", type=int, default=10)
+    parser.add_argument("--jobs", type=int, default=2)
+    args = parser.parse_args()
+    with Pool(args.jobs) as pool:
+        results = pool.map(measure, [(n, args.frames, args.stride) for n in args.sequences.split(",")])
+    print(f"{'sequence':14s} {'votes f1 %':>10s} {'votes k %':>10s} {'argmin (a)':>11s} {'argmin (b)':>11s}"
+          "   (argmin: mean distance from the truth, window sizes)")
+    for name, frame0, rows in results:
+        print(f"{name:14s} {100 * frame0:10.1f} {100 * rows[:, 0].mean():10.1f} {rows[:, 1].mean():11.3f}"
+              f" {rows[:, 2].mean():11.3f}")
+    allrows = np.vstack([r for _, _, r in results])
+    print(f"{'MEAN':14s} {100 * np.mean([f for _, f, _ in results]):10.1f} {100 * allrows[:, 0].mean():10.1f}"
+          f" {allrows[:, 1].mean():11.3f} {allrows[:, 2].mean():11.3f}")
+
+
+if __name__ == "__main__":
+    main()
