@@ -192,7 +192,7 @@ class IemdTracker:
             searches.append(candidate)
             if candidate.emd < best.emd:
                 best = candidate
-        scale, emd, scale_codings = self._search_scale(pyramid, best, size)
+        scale, emd, scale_codings, scale_warnings = self._search_scale(pyramid, best, size)
         new_center, new_size = best.center, size * scale
         best_box = _box(new_center, new_size, angle)
         visible = _visible_fraction(new_center, new_size, frame.shape)
@@ -212,7 +212,7 @@ class IemdTracker:
                     self._refresh_target()
         return TrackResult(
             box=best_box, emd=emd, iterations=best.iterations, lost=lost, scale=scale, angle=angle, starts=starts,
-            codings=codings + scale_codings, solver_warnings=sum(s.warnings for s in searches),
+            codings=codings + scale_codings, solver_warnings=sum(s.warnings for s in searches) + scale_warnings,
             predicted_box=predicted, reason=reason,
         )
 
@@ -289,7 +289,7 @@ class IemdTracker:
                 start, warnings = coarse.center, warnings + coarse.warnings
             model = self._candidate(pyramid, start, size)
             emd, solution = model.emd()
-            warnings += int(solution is not None and not solution.optimal)
+            warnings += _not_optimal(solution)
             scored.append((emd, model))
         best = self._descend(pyramid, min(scored, key=lambda item: item[0])[1])
         best.codings += len(scored) - 1  # the winner's model is the descent's first
@@ -321,7 +321,7 @@ class IemdTracker:
         axes = np.array([[c, -s], [s, c]])  # window axes -> image axes
         emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
         state = _Descent(center=model.center, emd=emd,
-                         warnings=int(sol is not None and not sol.optimal))
+                         warnings=_not_optimal(sol))
         # The coarse stage samples one pyramid level up: its steps are twice as long.
         level_scale = 2.0 if coarse else 1.0
         step, min_step = cfg.step_px * level_scale, cfg.min_step_px * level_scale
@@ -334,7 +334,7 @@ class IemdTracker:
             trial = self._candidate(pyramid, state.center - step * g_px / norm, size, coarse)
             e_try, s_try = trial.emd()
             state.codings += 1
-            state.warnings += int(s_try is not None and not s_try.optimal)
+            state.warnings += _not_optimal(s_try)
             if e_try < state.emd:  # the gradient is needed only where the step is accepted
                 state.center, state.emd, grad = trial.center, e_try, trial.gradient(cfg.gradient)
             else:
@@ -351,23 +351,23 @@ class IemdTracker:
         measured as runaway growth on Car4.)  In each direction the search keeps
         stepping by ``scale_step`` while the EMD decreases, up to ``scale_range``
         (the paper's gyro experiment searches +-10 %: a camera closing in on the
-        target grows it faster than 2 % per frame).  Returns (scale, emd, models built).
+        target grows it faster than 2 % per frame).  Returns (scale, emd, models built, solver warnings).
         """
         cfg = self.config
-        best_scale, best_emd, codings = 1.0, state.emd, 0
+        best_scale, best_emd, codings, warnings = 1.0, state.emd, 0, 0
         if cfg.scale_step == 0:
-            return best_scale, best_emd, codings
+            return best_scale, best_emd, codings, warnings
         n_steps = int(np.floor(cfg.scale_range / cfg.scale_step + 1e-9))
         for direction in (-1.0, 1.0):
             for n in range(1, n_steps + 1):
                 scale = 1.0 + direction * n * cfg.scale_step
                 emd, sol = self._candidate(pyramid, state.center, size * scale).emd()
                 codings += 1
-                state.warnings += int(sol is not None and not sol.optimal)
+                warnings += _not_optimal(sol)
                 if emd >= best_emd:
                     break
                 best_scale, best_emd = scale, emd
-        return best_scale, best_emd, codings
+        return best_scale, best_emd, codings, warnings
 
 
 def compile_jit() -> None:
@@ -388,6 +388,11 @@ def _box(center, size, angle: float = 0.0):
     c, s = abs(np.cos(angle)), abs(np.sin(angle))
     w, h = c * size[0] + s * size[1], s * size[0] + c * size[1]
     return tuple(float(v) for v in centre_box(center, (w, h)))
+
+
+def _not_optimal(solution) -> int:
+    """1 if an EMD solve ended without an optimal flow (counted in TrackResult.solver_warnings), else 0."""
+    return int(solution is not None and not solution.optimal)
 
 
 def _wrap_angle(angle: float) -> float:
