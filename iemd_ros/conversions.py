@@ -13,6 +13,7 @@ is what :class:`iemd_ros.IemdTracker` takes: ``HxW`` uint8 (grey) or ``HxWx3`` u
 from __future__ import annotations
 
 from functools import lru_cache
+from typing import NamedTuple
 
 import numpy as np
 
@@ -20,7 +21,8 @@ from .camera import CameraModel
 from .boxes import box_centre, centre_box, check_box
 
 __all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "camera_model_from_info", "camera_model_from_msg",
-           "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box"]
+           "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
+           "DetectionValues", "detection_values"]
 
 # encoding -> (channels, bytes per channel)
 ENCODINGS = {"mono8": (1, 1), "mono16": (1, 2), "bgr8": (3, 1), "rgb8": (3, 1), "bgra8": (4, 1), "rgba8": (4, 1)}
@@ -164,3 +166,19 @@ def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) 
     """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size."""
     box = centre_box([center_x, center_y], [size_x, size_y])
     return check_box(box, f"bounding box (centre ({center_x}, {center_y}), size {size_x} x {size_y})")
+
+
+class DetectionValues(NamedTuple):
+    """Values of the tracker's ``vision_msgs/Detection2D``: ``bbox`` ``(center_x, center_y, size_x, size_y)``
+    (``theta`` 0) and its one hypothesis' ``score``."""
+
+    bbox: tuple[float, float, float, float]
+    score: float
+
+
+def detection_values(result) -> DetectionValues | None:
+    """A :class:`~iemd_ros.pipeline.FrameResult` -> its detection's values (:func:`box_to_bbox` of its box,
+    its score); None when ``result`` is None or not tracking: no detection is published then."""
+    if result is None or not result.tracking:
+        return None
+    return DetectionValues(box_to_bbox(result.box), float(result.score))

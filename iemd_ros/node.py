@@ -41,8 +41,8 @@ from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithPose
 
 from .boxes import check_box
-from .conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_msg, image_to_array,
-                          stamp_ns)
+from .conversions import (array_to_image_fields, bbox_to_box, camera_model_from_msg, detection_values,
+                          image_to_array, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
 from .pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
@@ -412,15 +412,16 @@ class TrackerNode(Node):
         """The image's Detection2DArray: one detection while ``result`` is tracking, else empty."""
         out = Detection2DArray()
         out.header = img.header
-        if result is not None and result.tracking:
+        values = detection_values(result)
+        if values is not None:
             det = Detection2D()
             det.header = img.header
             det.id = self._detection_id
             c = det.bbox.center.position
-            c.x, c.y, det.bbox.size_x, det.bbox.size_y = box_to_bbox(result.box)
+            c.x, c.y, det.bbox.size_x, det.bbox.size_y = values.bbox
             hyp = ObjectHypothesisWithPose()
             hyp.hypothesis.class_id = self._class_id
-            hyp.hypothesis.score = float(result.score)
+            hyp.hypothesis.score = values.score
             det.results = [hyp]
             out.detections = [det]
         if self._stop or not self.context.ok():

@@ -53,7 +53,7 @@ from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Pro
 from .boxes import check_box
 from .camera import CameraModel
 from .cli import CliParser, cli_main
-from .conversions import box_to_bbox, camera_model_from_msg, image_to_array, stamp_ns
+from .conversions import camera_model_from_msg, detection_values, image_to_array, stamp_ns
 from .drawing import draw_result
 from .pipeline import INIT_REASON, FrameResult, PipelineConfig, TrackingPipeline
 
@@ -164,10 +164,11 @@ class _OutBag:
         M = b.msg
         hdr = header(b, DETECTIONS_TOPIC, r.stamp_ns, frame_id)
         dets = []
-        if r.tracking:
-            cx, cy, sx, sy = box_to_bbox(r.box)
+        values = detection_values(r)
+        if values is not None:
+            cx, cy, sx, sy = values.bbox
             hyp = M("vision_msgs/msg/ObjectHypothesisWithPose")(
-                hypothesis=M("vision_msgs/msg/ObjectHypothesis")(class_id=CLASS_ID, score=float(r.score)),
+                hypothesis=M("vision_msgs/msg/ObjectHypothesis")(class_id=CLASS_ID, score=values.score),
                 pose=M("geometry_msgs/msg/PoseWithCovariance")(
                     pose=M("geometry_msgs/msg/Pose")(
                         position=M("geometry_msgs/msg/Point")(x=0.0, y=0.0, z=0.0),

@@ -6,7 +6,8 @@ import pytest
 
 from iemd_ros.boxes import box_centre, centre_box, check_box
 from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info,
-                                  image_to_array, ns_to_stamp, stamp_to_ns)
+                                  detection_values, image_to_array, ns_to_stamp, stamp_to_ns)
+from iemd_ros.pipeline import FrameResult
 
 
 @pytest.fixture
@@ -106,6 +107,15 @@ def test_box_bbox_round_trip():
         bbox_to_box(1, 1, 0, 5)
     with pytest.raises(ValueError, match="finite"):
         bbox_to_box(float("nan"), 1, 3, 5)
+
+
+def test_detection_values_only_while_tracking():
+    box = (10.0, 20.0, 4.0, 6.0)
+    v = detection_values(FrameResult(0, "tracking", box, score=0.75))
+    assert v.bbox == (11.5, 22.5, 4.0, 6.0) and v.score == 0.75 and type(v.score) is float
+    assert detection_values(None) is None
+    assert detection_values(FrameResult(0, "lost", box, lost=True)) is None
+    assert detection_values(FrameResult(0, "tracking", box, score=0.75, rejected="stamp repeats")) is None
 
 
 def test_box_centre_and_centre_box_are_inverse():
