@@ -284,10 +284,11 @@ class ImuBuffer:
 def _window_rotation(rel, ws, t_end, coning):
     """Quaternion of :func:`iemd_ros.rotation.integrate_rates` over [0, t_end] for samples at ``rel``.
 
-    ``rel`` (s, strictly increasing) brackets the window: rel[0] <= 0 and rel[-1] >= t_end.  The
-    knots are 0, the samples strictly inside and t_end, with the rate interpolated linearly at both
-    ends (as ``np.interp``).  One compiled pass: the numpy version spent ~0.3 ms per frame in array
-    overhead for a handful of samples.
+    ``rel`` (s, strictly increasing) brackets the window: rel[0] <= 0 < t_end <= rel[-1], so it
+    holds at least 2 samples (``integrate`` answers an empty window before calling).  The knots are
+    0, the samples strictly inside and t_end, with the rate interpolated linearly at both ends (as
+    ``np.interp``).  One compiled pass: the numpy version spent ~0.3 ms per frame in array overhead
+    for a handful of samples.
     """
     knots = np.empty(rel.size + 2)
     rates = np.empty((rel.size + 2, 3))
@@ -303,10 +304,9 @@ def _window_rotation(rel, ws, t_end, coning):
 
 @numba.njit(cache=True)
 def _interp_rate(rel, ws, x):
+    """Rate at ``x`` interpolated linearly in ``ws`` at ``rel`` (at least 2 samples), clamped at the ends."""
     j = 0
     while j < rel.size - 2 and rel[j + 1] < x:
         j += 1
-    if rel.size == 1:
-        return ws[0].copy()
     f = min(max((x - rel[j]) / (rel[j + 1] - rel[j]), 0.0), 1.0)
     return ws[j] + f * (ws[j + 1] - ws[j])
