@@ -183,13 +183,13 @@ class ImuBuffer:
         pt = np.concatenate(self._pend_t)
         pw = np.concatenate(self._pend_w)
         self._pend_t, self._pend_w, self._n_pend = [], [], 0
-        order = np.argsort(pt, kind="stable")
-        pt, pw = pt[order], pw[order]
         t, w = np.concatenate([self._t, pt]), np.concatenate([self._w, pw])
         n = np.concatenate([self._n, np.ones(len(pt))])
-        if len(self._t) and pt[0] <= self._t[-1]:   # reaching back into the store: sort it all again
-            order = np.argsort(t, kind="stable")     # (usually all pending samples are newer: appended)
-            t, w, n = t[order], w[order], n[order]
+        # usually all pending samples are newer than the store: only they are sorted, then appended;
+        # reaching back into it, one stable sort of it all (the store first, arrivals in order)
+        lo = 0 if len(self._t) and pt.min() <= self._t[-1] else len(self._t)
+        order = np.argsort(t[lo:], kind="stable")
+        t[lo:], w[lo:], n[lo:] = t[lo:][order], w[lo:][order], n[lo:][order]
         start = np.flatnonzero(np.concatenate([[True], t[1:] != t[:-1]]))  # first of each stamp (t sorted)
         if len(start) < len(t):
             self.counts["duplicates"] += len(t) - len(start)
