@@ -102,12 +102,7 @@ class ImuBuffer:
 
     def __init__(self, max_duration_ns: int = 10_000_000_000, max_samples: int = 20_000,
                  saturation: float | None = None, max_gap_ns: int = 50_000_000):
-        if int(max_duration_ns) <= 0 or int(max_samples) < 2:
-            raise ValueError(f"need max_duration_ns > 0 and max_samples >= 2, got {max_duration_ns}, {max_samples}")
-        if saturation is not None and not saturation > 0:
-            raise ValueError(f"saturation limit must be > 0 rad/s or None, got {saturation}")
-        if int(max_gap_ns) <= 0:
-            raise ValueError(f"max_gap_ns must be > 0, got {max_gap_ns}")
+        self.check_settings(max_duration_ns, max_samples, saturation, max_gap_ns)
         self.max_duration_ns = int(max_duration_ns)
         self.max_samples = int(max_samples)
         self.saturation = None if saturation is None else float(saturation)
@@ -123,6 +118,16 @@ class ImuBuffer:
         self._t_integrated: int | None = None  # largest window end integrated so far
         self.counts = dict(added=0, accepted=0, nan=0, saturated=0, duplicates=0,
                            out_of_order=0, late=0, dropped=0)
+
+    @staticmethod
+    def check_settings(max_duration_ns, max_samples, saturation, max_gap_ns) -> None:
+        """ValueError unless the parameters are valid (see the class docstring)."""
+        if int(max_duration_ns) <= 0 or int(max_samples) < 2:
+            raise ValueError(f"need max_duration_ns > 0 and max_samples >= 2, got {max_duration_ns}, {max_samples}")
+        if saturation is not None and not saturation > 0:
+            raise ValueError(f"saturation limit must be > 0 rad/s or None, got {saturation}")
+        if int(max_gap_ns) <= 0:
+            raise ValueError(f"max_gap_ns must be > 0, got {max_gap_ns}")
 
     # ------------------------------------------------------------------ input
     def add(self, t_ns, w) -> np.ndarray:

@@ -75,9 +75,7 @@ def gyro_config_from_dict(values: dict) -> GyroConfig:
             if float(v[key]) != int(v[key]):
                 raise ValueError(f"gyro {key} must be an integer, got {v[key]!r}")
             v[key] = int(v[key])
-    cfg = GyroConfig(**v)
-    GyroPredictor(None, cfg)                # the predictor's own checks (rotation, bias, buffer limits)
-    return cfg
+    return GyroConfig(**v)
 
 
 def gyro_config_to_dict(cfg: GyroConfig) -> dict:
