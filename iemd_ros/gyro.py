@@ -171,6 +171,7 @@ class GyroConfig:
     ``still_bias_samples``: if > 0, estimate the bias from the first N samples when their per-axis
     std is below ``still_bias_max_std`` (rad/s); it then replaces ``bias``.
     ``allow_gaps``: use a rotation integrated across a gap > ``max_gap_ns`` (else no prior).
+    Checked when built (ValueError): extrinsic and bias, buffer limits, still-bias settings.
     """
 
     time_offset_ns: int = 0
@@ -184,6 +185,11 @@ class GyroConfig:
     buffer_samples: int = 20_000
     allow_gaps: bool = False
     coning: bool = True
+
+    def __post_init__(self):
+        GyroCalibration.checked(self.R_cam_imu, self.bias)
+        ImuBuffer.check_settings(self.buffer_ns, self.buffer_samples, self.saturation, self.max_gap_ns)
+        StillBiasEstimator.check_settings(self.still_bias_samples, self.still_bias_max_std)
 
 
 @dataclass(frozen=True)
@@ -222,6 +228,7 @@ class GyroPredictor:
     new frame yet, the result has ``status == not_covered`` and no prior: wait a bounded time
     (:meth:`ready`) and call again, or go on without the prior and log ``reason``.  ``camera`` may be
     None until the calibration is known (set it then): samples are buffered, :meth:`predict` needs it.
+    ``config`` is valid by construction (:class:`GyroConfig` checks itself).
     """
 
     def __init__(self, camera: CameraModel | None, config: GyroConfig | None = None):

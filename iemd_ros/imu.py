@@ -102,12 +102,7 @@ class ImuBuffer:
 
     def __init__(self, max_duration_ns: int = 10_000_000_000, max_samples: int = 20_000,
                  saturation: float | None = None, max_gap_ns: int = 50_000_000):
-        if int(max_duration_ns) <= 0 or int(max_samples) < 2:
-            raise ValueError(f"need max_duration_ns > 0 and max_samples >= 2, got {max_duration_ns}, {max_samples}")
-        if saturation is not None and not saturation > 0:
-            raise ValueError(f"saturation limit must be > 0 rad/s or None, got {saturation}")
-        if int(max_gap_ns) <= 0:
-            raise ValueError(f"max_gap_ns must be > 0, got {max_gap_ns}")
+        self.check_settings(max_duration_ns, max_samples, saturation, max_gap_ns)
         self.max_duration_ns = int(max_duration_ns)
         self.max_samples = int(max_samples)
         self.saturation = None if saturation is None else float(saturation)
@@ -123,6 +118,16 @@ class ImuBuffer:
         self._t_integrated: int | None = None  # largest window end integrated so far
         self.counts = dict(added=0, accepted=0, nan=0, saturated=0, duplicates=0,
                            out_of_order=0, late=0, dropped=0)
+
+    @staticmethod
+    def check_settings(max_duration_ns, max_samples, saturation, max_gap_ns) -> None:
+        """ValueError unless the parameters are valid (see the class docstring)."""
+        if int(max_duration_ns) <= 0 or int(max_samples) < 2:
+            raise ValueError(f"need max_duration_ns > 0 and max_samples >= 2, got {max_duration_ns}, {max_samples}")
+        if saturation is not None and not saturation > 0:
+            raise ValueError(f"saturation limit must be > 0 rad/s or None, got {saturation}")
+        if int(max_gap_ns) <= 0:
+            raise ValueError(f"max_gap_ns must be > 0, got {max_gap_ns}")
 
     # ------------------------------------------------------------------ input
     def add(self, t_ns, w) -> np.ndarray:
@@ -183,13 +188,13 @@ class ImuBuffer:
         pt = np.concatenate(self._pend_t)
         pw = np.concatenate(self._pend_w)
         self._pend_t, self._pend_w, self._n_pend = [], [], 0
-        order = np.argsort(pt, kind="stable")
-        pt, pw = pt[order], pw[order]
         t, w = np.concatenate([self._t, pt]), np.concatenate([self._w, pw])
         n = np.concatenate([self._n, np.ones(len(pt))])
-        if len(self._t) and pt[0] <= self._t[-1]:   # reaching back into the store: sort it all again
-            order = np.argsort(t, kind="stable")     # (usually all pending samples are newer: appended)
-            t, w, n = t[order], w[order], n[order]
+        # usually all pending samples are newer than the store: only they are sorted, then appended;
+        # reaching back into it, one stable sort of it all (the store first, arrivals in order)
+        lo = 0 if len(self._t) and pt.min() <= self._t[-1] else len(self._t)
+        order = np.argsort(t[lo:], kind="stable")
+        t[lo:], w[lo:], n[lo:] = t[lo:][order], w[lo:][order], n[lo:][order]
         start = np.flatnonzero(np.concatenate([[True], t[1:] != t[:-1]]))  # first of each stamp (t sorted)
         if len(start) < len(t):
             self.counts["duplicates"] += len(t) - len(start)
@@ -284,10 +289,11 @@ class ImuBuffer:
 def _window_rotation(rel, ws, t_end, coning):
     """Quaternion of :func:`iemd_ros.rotation.integrate_rates` over [0, t_end] for samples at ``rel``.
 
-    ``rel`` (s, strictly increasing) brackets the window: rel[0] <= 0 and rel[-1] >= t_end.  The
-    knots are 0, the samples strictly inside and t_end, with the rate interpolated linearly at both
-    ends (as ``np.interp``).  One compiled pass: the numpy version spent ~0.3 ms per frame in array
-    overhead for a handful of samples.
+    ``rel`` (s, strictly increasing) brackets the window: rel[0] <= 0 < t_end <= rel[-1], so it
+    holds at least 2 samples (``integrate`` answers an empty window before calling).  The knots are
+    0, the samples strictly inside and t_end, with the rate interpolated linearly at both ends (as
+    ``np.interp``).  One compiled pass: the numpy version spent ~0.3 ms per frame in array overhead
+    for a handful of samples.
     """
     knots = np.empty(rel.size + 2)
     rates = np.empty((rel.size + 2, 3))
@@ -303,10 +309,9 @@ def _window_rotation(rel, ws, t_end, coning):
 
 @numba.njit(cache=True)
 def _interp_rate(rel, ws, x):
+    """Rate at ``x`` interpolated linearly in ``ws`` at ``rel`` (at least 2 samples), clamped at the ends."""
     j = 0
     while j < rel.size - 2 and rel[j + 1] < x:
         j += 1
-    if rel.size == 1:
-        return ws[0].copy()
     f = min(max((x - rel[j]) / (rel[j + 1] - rel[j]), 0.0), 1.0)
     return ws[j] + f * (ws[j + 1] - ws[j])

@@ -75,9 +75,7 @@ def gyro_config_from_dict(values: dict) -> GyroConfig:
             if float(v[key]) != int(v[key]):
                 raise ValueError(f"gyro {key} must be an integer, got {v[key]!r}")
             v[key] = int(v[key])
-    cfg = GyroConfig(**v)
-    GyroPredictor(None, cfg)                # the predictor's own checks (rotation, bias, buffer limits)
-    return cfg
+    return GyroConfig(**v)
 
 
 def gyro_config_to_dict(cfg: GyroConfig) -> dict:
@@ -283,7 +281,7 @@ class TrackingPipeline:
     def _rebuild_predictor(self) -> None:
         """New GyroPredictor for the current gyro config, fed the samples buffered so far."""
         t, w = self._predictor.buffer.samples()
-        self._predictor = GyroPredictor(self._predictor.camera, self._cfg.gyro)
+        self._predictor = self._new_predictor()
         if len(t):
             self._predictor.add_imu(t, w)
 
@@ -301,19 +299,21 @@ class TrackingPipeline:
             c = self.counters
             c["imu_received"] += 1
             newest = self._predictor.buffer.t_newest_ns
-            status = int(self._predictor.add_imu(t, w)[0])
+            back = 0 if newest is None else newest - t
+            reset = back > self._cfg.clock_reset_ms * 1e6
+            # on a clock reset the sample goes to a new predictor, kept only if the sample is accepted
+            predictor = self._new_predictor() if reset else self._predictor
+            status = int(predictor.add_imu(t, w)[0])
             if status == SampleStatus.NOT_FINITE:
                 return self._reject_imu("imu_rejected", f"IMU sample at {t} ns rejected: angular velocity "
                                                         f"{w.tolist()} is not 3 finite values")
             if status == SampleStatus.SATURATED:
                 return self._reject_imu("imu_saturated", f"IMU sample at {t} ns rejected: |w| reaches the "
                                                          f"saturation limit {self._cfg.gyro.saturation} rad/s")
-            back = 0 if newest is None else newest - t
-            if back > self._cfg.clock_reset_ms * 1e6:
+            if reset:
                 c["clock_resets"] += 1
                 self._last["imu_reason"] = f"IMU clock jumped back by {_ms(back)}: IMU buffer restarted"
-                self._clear_imu()
-                self._predictor.add_imu(t, w)                 # the first sample on the new clock
+                self._predictor = predictor                   # holding the first sample on the new clock
             elif back > 0:
                 c["imu_out_of_order"] += 1
                 self._last["imu_reason"] = f"IMU stamp went back by {_ms(back)} (sample put in order)"
@@ -340,8 +340,9 @@ class TrackingPipeline:
             self.counters["imu_received"] += 1
             self._reject_imu("imu_rejected", reason)
 
-    def _clear_imu(self) -> None:
-        self._predictor = GyroPredictor(self._predictor.camera, self._cfg.gyro)
+    def _new_predictor(self) -> GyroPredictor:
+        """An empty GyroPredictor for the current camera and gyro configuration."""
+        return GyroPredictor(self._predictor.camera, self._cfg.gyro)
 
     def note_dropped(self, stamp_ns: int, reason: str = "a newer frame arrived before this one was processed") -> None:
         """Count a frame the caller skipped (e.g. stale: processing fell behind)."""
@@ -443,7 +444,7 @@ class TrackingPipeline:
                 self._ref = (t, self._ref[1], self._ref[2])     # no rotation can be integrated across it
             newest = self._predictor.buffer.t_newest_ns
             if newest is not None and newest > self._predictor.imu_time(t) + self._cfg.clock_reset_ms * 1e6:
-                self._clear_imu()          # the IMU is still on the old clock
+                self._predictor = self._new_predictor()   # the IMU is still on the old clock
             return ""
         if back == 0:
             return f"image stamp {t} ns repeats the previous frame's"

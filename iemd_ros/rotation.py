@@ -205,14 +205,21 @@ class GyroCalibration:
     bias: np.ndarray = None  # type: ignore[assignment]
 
     def __post_init__(self):
-        R = np.eye(3) if self.R_cam_imu is None else np.asarray(self.R_cam_imu, dtype=float)
-        b = np.zeros(3) if self.bias is None else np.asarray(self.bias, dtype=float)
+        R, b = self.checked(self.R_cam_imu, self.bias)
+        object.__setattr__(self, "R_cam_imu", R)
+        object.__setattr__(self, "bias", b)
+
+    @staticmethod
+    def checked(R_cam_imu, bias) -> tuple[np.ndarray, np.ndarray]:
+        """``(R_cam_imu, bias)`` as arrays (None: identity, zeros); ValueError unless a proper
+        rotation and 3 finite values."""
+        R = np.eye(3) if R_cam_imu is None else np.asarray(R_cam_imu, dtype=float)
+        b = np.zeros(3) if bias is None else np.asarray(bias, dtype=float)
         if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
             raise ValueError(f"R_cam_imu must be a proper 3x3 rotation matrix, got {R.tolist()}")
         if b.shape != (3,) or not np.all(np.isfinite(b)):
             raise ValueError(f"gyro bias must be 3 finite values (rad/s), got {b.tolist()}")
-        object.__setattr__(self, "R_cam_imu", R)
-        object.__setattr__(self, "bias", b)
+        return R, b
 
     def to_camera(self, w_imu) -> np.ndarray:
         """Camera-frame rates of (N, 3) IMU-frame rates."""
@@ -227,15 +234,20 @@ class StillBiasEstimator:
     """
 
     def __init__(self, n: int = 0, max_std: float = 0.02):
-        if n < 0 or (n == 1):
-            raise ValueError(f"still-bias sample count must be 0 (off) or >= 2, got {n}")
-        if not max_std > 0:
-            raise ValueError(f"still-bias max_std must be > 0 rad/s, got {max_std}")
+        self.check_settings(n, max_std)
         self.n, self.max_std = int(n), float(max_std)
         self._buf: list[np.ndarray] = []
         self.bias: np.ndarray | None = None
         self.done = self.n == 0
         self.status = "off" if self.n == 0 else f"collecting 0/{self.n} samples"
+
+    @staticmethod
+    def check_settings(n, max_std) -> None:
+        """ValueError unless ``n`` is 0 (off) or >= 2 and ``max_std > 0``."""
+        if n < 0 or (n == 1):
+            raise ValueError(f"still-bias sample count must be 0 (off) or >= 2, got {n}")
+        if not max_std > 0:
+            raise ValueError(f"still-bias max_std must be > 0 rad/s, got {max_std}")
 
     def update(self, w) -> bool:
         """Feed (3,) or (N, 3) finite IMU-frame rates; returns True once an estimate exists."""

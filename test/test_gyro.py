@@ -154,6 +154,17 @@ def test_bad_arguments():
         rotation_homography(DESK_K, np.eye(2))
 
 
+def test_gyro_config_checks_itself():
+    """The checks of the predictor's parts, raised by the configuration when built."""
+    bad = [({"R_cam_imu": np.diag([1.0, 1.0, -1.0])}, "proper 3x3 rotation"), ({"bias": [0.0, np.nan, 0.0]}, "bias"),
+           ({"buffer_samples": 1}, "max_samples >= 2"), ({"buffer_ns": 0}, "max_duration_ns > 0"),
+           ({"saturation": 0.0}, "saturation limit"), ({"max_gap_ns": 0}, "max_gap_ns must be > 0"),
+           ({"still_bias_samples": 1}, "still-bias sample count"), ({"still_bias_max_std": 0.0}, "still-bias max_std")]
+    for kw, msg in bad:
+        with pytest.raises(ValueError, match=msg):
+            GyroConfig(**kw)
+
+
 def test_real_desk_prewarp_direction(imu_root):
     """On the 6 fastest desk pairs K R^T K^-1 cuts the grey-level error; K R K^-1 raises it."""
     from iemd_ros.recordings import load_recording

@@ -92,6 +92,21 @@ def test_equal_stamps_with_different_values_are_averaged():
     assert buf.stats()["duplicates"] == 1
 
 
+def test_later_batches_reaching_back_into_the_store_or_appended():
+    """Samples merged after the store: sorted in (equal stamps weighted by what each entry holds)."""
+    buf = ImuBuffer()
+    buf.add(T0 + np.array([0, 10, 10, 20, 30]) * MS, [[0, 0, 0], [1, 0, 0], [3, 0, 0], [2, 0, 0], [4, 0, 0]])
+    assert len(buf) == 4                                        # stored: 10 ms holds the mean 2 of 2 samples
+    buf.add(T0 + np.array([25, 10, 40, 5, 25]) * MS, [[6, 0, 0], [5, 0, 0], [8, 0, 0], [1, 0, 0], [2, 0, 0]])
+    assert len(buf) == 7                                        # reaching back: 5, 10 and 25 ms
+    buf.add(T0 + np.array([60, 50, 55, 50]) * MS, [[9, 0, 0], [7, 0, 0], [1, 0, 0], [3, 0, 0]])   # appended
+    t, w = buf.samples()
+    assert list((t - T0) // MS) == [0, 5, 10, 20, 25, 30, 40, 50, 55, 60]
+    np.testing.assert_array_equal(w[:, 0], [0, 1, 3, 2, 4, 4, 8, 5, 1, 9])   # 10 ms: (2 * 2 + 5) / 3
+    st = buf.stats()
+    assert (st["duplicates"], st["out_of_order"], st["stored"]) == (4, 7, 10)
+
+
 def test_clock_stepping_back_like_the_cmu_desk_log():
     """Rows 77139, 77169, 77159, 77169, 77179 ms (the desk pattern) are put in order and counted."""
     t_ms = np.array([77119, 77129, 77139, 77169, 77159, 77169, 77179, 77189])

@@ -132,11 +132,16 @@ def test_imu_validation_counts_and_explains(seq):
     p.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
     assert p.diagnostics()["imu_rejected"] == 13 and "covariance" in p.statuses()[2].message
     # a clock reset (bag loop): the IMU buffer restarts; a rejected sample stamped back there does not
+    old = p._predictor.buffer
+    added = old.stats()["added"]
     assert not p.add_imu(t0 - 5_000_000_000, (np.nan, 0.0, 0.0))
     assert p.diagnostics()["clock_resets"] == 0
     assert p.add_imu(t0 - 5_000_000_000, (0.0, 0.0, 0.0))
     d = p.diagnostics()
     assert d["clock_resets"] == 1 and d["imu_stored"] == 1 and "jumped back" in d["imu_reason"]
+    assert p._predictor.buffer is not old and old.stats()["added"] == added     # the old buffer never saw them
+    st = p._predictor.buffer.stats()
+    assert (st["added"], st["accepted"], st["out_of_order"]) == (1, 1, 0)      # added once, to the new buffer
 
 
 def test_imu_before_camera_info_is_screened_and_held(seq):
