@@ -124,6 +124,10 @@ class IemdTracker:
     (median update 11.3 vs 13.9 ms in the same run).  Per-sequence figures swing
     by tens of points with small changes (a tracker that loses the target early
     scores near zero), so only the 12-sequence mean is used for such choices.
+
+    Algorithm 2 (``update_templates``) neither helps nor hurts that mean: 31.9 % with it, 32.0 %
+    without.  Runs end by drifting, not by losing the target: Woman, David and Car4 sit on
+    background for 457, 268 and 320 frames with an EMD still below the lost threshold.
     """
 
     def __init__(self, config: TrackerConfig | None = None):
