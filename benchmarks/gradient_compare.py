@@ -15,7 +15,7 @@ import argparse
 
 import numpy as np
 
-from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros import IemdTracker
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.otb import default_root, load_sequence, read_frame
@@ -39,9 +39,10 @@ def main():
             pyramid = ImagePyramid(to_gray(cur))
             truth, size = box_centre(seq.gt_boxes[k]), np.asarray(seq.gt_boxes[k][2:], dtype=float)
             offsets = rng.uniform(-args.offset, args.offset, (args.starts, 2))
+            tracker = IemdTracker()
+            tracker.init(prev, seq.gt_boxes[k - 1])
             for gradient in GRADIENTS:
-                tracker = IemdTracker(TrackerConfig(gradient=gradient))
-                tracker.init(prev, seq.gt_boxes[k - 1])
+                tracker.config.gradient = gradient  # only the descent reads it
                 for offset in offsets:
                     state = tracker._descend(pyramid, tracker._candidate(pyramid, truth + offset, size))
                     errors[gradient].append(np.linalg.norm(state.center - truth))

@@ -29,19 +29,24 @@ from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
-from iemd_ros.otb import default_root, load_sequence, read_frame
+from iemd_ros.otb import default_root, list_sequences, load_sequence, read_frame
 
 OFFSETS = np.linspace(-0.6, 0.6, 13)
 CAPTURE_STARTS = (0.05, 0.1, 0.2, 0.3, 0.4)
-SEQUENCES = "Bolt2,Car4,Couple,David,Deer,DragonBaby,Freeman1,Jogging-1,Jogging-2,MotorRolling,Skiing,Woman"
+
+
+def grid_argmin(score, centre, size, offsets=OFFSETS) -> np.ndarray:
+    """Offset (dx, dy), in window sizes, of the lowest ``score(window centre)`` on the grid of ``offsets``."""
+    values = np.array([[score(centre + (dx * size[0], dy * size[1])) for dx in offsets] for dy in offsets])
+    iy, ix = np.unravel_index(np.argmin(values), values.shape)
+    return np.array([offsets[ix], offsets[iy]])
 
 
 def _grid_argmin_iou(score, truth) -> float:
     """IoU with ``truth`` of the window of the lowest ``score(centre)`` on the offset grid."""
-    centre, size = box_centre(truth), truth[2:]
-    values = np.array([[score(centre + (dx * size[0], dy * size[1])) for dx in OFFSETS] for dy in OFFSETS])
-    iy, ix = np.unravel_index(np.argmin(values), values.shape)
-    best = (truth[0] + OFFSETS[ix] * size[0], truth[1] + OFFSETS[iy] * size[1], size[0], size[1])
+    size = truth[2:]
+    dx, dy = grid_argmin(score, box_centre(truth), size)
+    best = (truth[0] + dx * size[0], truth[1] + dy * size[1], size[0], size[1])
     return float(iou(np.array([best]), truth[None])[0])
 
 
@@ -96,13 +101,14 @@ def capture(name):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--sequences", default=SEQUENCES)
+    parser.add_argument("--sequences", default=None, help="comma-separated (default: all in ../shared/data/otb)")
     parser.add_argument("--stride", type=int, default=10)
     parser.add_argument("--jump", type=int, default=3)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--capture", action="store_true", help="also measure the descent's capture range")
     args = parser.parse_args()
-    jobs = [(name, args.stride, args.jump) for name in args.sequences.split(",")]
+    names = args.sequences.split(",") if args.sequences else list_sequences(default_root())
+    jobs = [(name, args.stride, args.jump) for name in names]
     with Pool(args.jobs) as pool:
         results = pool.map(measure, jobs)
     print(f"{'sequence':14s} {'grid EMD':>9s} {'grid NCC':>9s} {'step iEMD':>10s} {'stay':>6s}   (mean IoU %)")
@@ -112,7 +118,7 @@ def main():
     print(f"{'mean':14s} {mean[0]:9.1f} {mean[1]:9.1f} {mean[2]:10.1f} {mean[3]:6.1f}")
     if args.capture:
         with Pool(args.jobs) as pool:
-            shares = pool.map(capture, args.sequences.split(","))
+            shares = pool.map(capture, names)
         print("\ncapture range: % of searches ending within 0.05 window sizes, by start distance (window sizes)")
         print(f"{'sequence':14s} " + " ".join(f"{d:>6}" for d in CAPTURE_STARTS))
         for name, share in shares + [("mean", np.mean([v for _, v in shares], axis=0))]:

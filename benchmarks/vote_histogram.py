@@ -3,6 +3,8 @@
 
     python benchmarks/vote_histogram.py [--sequences Car4,Bolt2,Woman] [--frames 100] [--stride 10]
 
+Default: every sequence in ../shared/data/otb.
+
 Section 4 can be read two ways.
 
 (a) The tracker's (iemd_ros.candidate): every local patch r is a bin; its mass is its pooled code
@@ -15,7 +17,7 @@ Section 4 can be read two ways.
 
 (b) can only localize if a patch's largest code names the place in the target it came from.  For
 every ``stride``-th frame k of the first ``frames`` (target model and dictionary of frame 1, as the
-tracker builds them; window at the ground truth of frame k), this prints:
+tracker builds them; window of the frame-1 size at the ground truth of frame k), this prints:
 
 * votes: the share of dense (step 2) patches inside the kernel whose largest code is an atom
   within one patch step (0.3 half-widths) of their own position;
@@ -35,7 +37,8 @@ from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.emd import ground_distance, solve_emd
 from iemd_ros.histogram import candidate_weights
-from iemd_ros.otb import default_root, load_sequence, read_frame
+from iemd_ros.otb import default_root, list_sequences, load_sequence, read_frame
+from model_ceiling import grid_argmin  # benchmarks/ is the script's directory
 
 OFFSETS = np.linspace(-0.4, 0.4, 9)
 DENSE_STEP = 2
@@ -80,13 +83,6 @@ class VoteHistogram:
         return float(near[inside].mean())
 
 
-def _argmin_distance(score, center, size) -> float:
-    """Distance (window sizes) from the centre to the lowest score on the offset grid."""
-    grid = [(dx, dy) for dy in OFFSETS for dx in OFFSETS]
-    values = [score(center + np.array(off) * size) for off in grid]
-    return float(np.hypot(*grid[int(np.argmin(values))]))
-
-
 def measure(job):
     name, frames, stride = job
     seq = load_sequence(name, default_root())
@@ -99,8 +95,9 @@ def measure(job):
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
         center, size = box_centre(seq.gt_boxes[k]), tracker._size
         accuracy = votes.vote_accuracy(pyramid.sample(center, size, tsize))
-        patch_bins = _argmin_distance(lambda c: tracker._candidate(pyramid, c, size).emd()[0], center, size)
-        vote_bins = _argmin_distance(lambda c: votes.emd(pyramid.sample(c, size, tsize)), center, size)
+        patch_bins = np.hypot(*grid_argmin(lambda c: tracker._candidate(pyramid, c, size).emd()[0], center, size,
+                                           OFFSETS))
+        vote_bins = np.hypot(*grid_argmin(lambda c: votes.emd(pyramid.sample(c, size, tsize)), center, size, OFFSETS))
         rows.append((accuracy, patch_bins, vote_bins))
     frame0 = votes.vote_accuracy(tracker.dictionary.templates[0])
     return name, frame0, np.array(rows)
@@ -108,13 +105,14 @@ def measure(job):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--sequences", default="Car4,Bolt2,Woman")
+    parser.add_argument("--sequences", default=None, help="comma-separated (default: all in ../shared/data/otb)")
     parser.add_argument("--frames", type=int, default=100, help="frames 1..N of each sequence")
     parser.add_argument("--stride", type=int, default=10)
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     with Pool(args.jobs) as pool:
-        results = pool.map(measure, [(n, args.frames, args.stride) for n in args.sequences.split(",")])
+        names = args.sequences.split(",") if args.sequences else list_sequences(default_root())
+        results = pool.map(measure, [(n, args.frames, args.stride) for n in names])
     print(f"{'sequence':14s} {'votes f1 %':>10s} {'votes k %':>10s} {'argmin (a)':>11s} {'argmin (b)':>11s}"
           "   (argmin: mean distance from the truth, window sizes)")
     for name, frame0, rows in results:

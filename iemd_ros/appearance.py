@@ -3,7 +3,8 @@
 Geometry conventions (0-based image pixels, pixel centres at integer
 coordinates): a window is its centre ``(cx, cy)`` and size ``(w, h)``.
 Template pixel ``u`` (0..T-1) samples image point
-``cx + (u - (T-1)/2) * w/T``.  Patch positions ``c`` are the patch centres
+``cx + (u - (T-1)/2) * w/T`` along the window's x axis, which a window turned by
+``angle`` points along (cos, sin) (:meth:`ImagePyramid.sample`).  Patch positions ``c`` are the patch centres
 relative to the window centre in *normalized window units*: the window spans
 [-1, 1] on each axis, so positions, the spatial kernel and the spatial term of
 the ground distance do not depend on the target's size in pixels.
@@ -34,7 +35,7 @@ class ImagePyramid:
     """
 
     def __init__(self, gray: np.ndarray, max_levels: int = 4):
-        self.levels = [gray]  # built on demand by level(): most frames only need one or two
+        self._levels = [gray]  # built on demand by level(): most frames only need one or two
         h, w = gray.shape[:2]
         self.n_levels = 1
         while self.n_levels <= max_levels and min(h, w) >= 32:
@@ -43,9 +44,9 @@ class ImagePyramid:
 
     def level(self, index: int) -> np.ndarray:
         """Pyramid level ``index`` (0: the frame), computed with the ones below it on first use."""
-        while len(self.levels) <= index:
-            self.levels.append(cv2.pyrDown(self.levels[-1]))
-        return self.levels[index]
+        while len(self._levels) <= index:
+            self._levels.append(cv2.pyrDown(self._levels[-1]))
+        return self._levels[index]
 
     def sample(self, center, size, template_size, coarse: int = 0, angle: float = 0.0) -> np.ndarray:
         """Resample a window to a (Th, Tw) template; ``template_size`` is (Tw, Th).

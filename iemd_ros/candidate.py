@@ -63,6 +63,7 @@ class CandidateModel:
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
         self.coarse = coarse  # pyramid levels above the anti-aliasing level it was sampled at
+        self.angle = angle
         self.target = target
         self.alpha = alpha
         self.bandwidth = bandwidth

@@ -20,7 +20,7 @@ the residual updated row-wise in place it codes 49 patches in 0.4 ms against
 lambda (the paper gives no value; the tracker's default is 0.1): with zero-mean
 unit patches and 3 templates (147 atoms), lambda = 0.01 gave 35 non-zeros per
 patch and 22 ms per 49 patches, 0.1 gave 15 and 2.6 ms, 0.2 gave 10.6 and 1.4 ms
-(Bolt2, this machine), while the EMD's discrimination between target and
+(Bolt2, this machine, before the row-wise residual update), while the EMD's discrimination between target and
 background (benchmarks/tune_tracker.py --discrimination) stayed the same
 (17.6 % at 0.01 and 0.1, 16.7 % at 0.4).
 """

@@ -38,7 +38,7 @@ class TrackerConfig:
     gradient: str = "appearance"  # "appearance", "envelope" or "paper" (eq. 10): see CandidateModel.gradient
     coarse_to_fine: bool = True  # first descend on the next pyramid level (wider convergence region)
     scale_step: float = 0.02  # relative scale variants tried at the converged position
-    scale_range: float = 0.02  # largest scale change per frame, in scale_step steps (paper's gyro run: 0.1)
+    scale_range: float = 0.02  # largest relative scale change searched per frame, in scale_step steps (gyro run: 0.1)
     n_particles: int = 4  # extra starting points for abrupt motion (section 6.1)
     particle_offset: float = 0.5  # their distance from the prediction, in window sizes
     # Thresholds relative to the background EMD; measured EMD/background while tracking
@@ -110,7 +110,7 @@ class _Descent:
     center: np.ndarray  # window centre, image pixels
     emd: float
     iterations: int = 0
-    codings: int = 1  # candidate models built (each sparse-codes one window)
+    codings: int = 0  # candidate models built for its trial steps (the caller counts the start's)
     warnings: int = 0
 
 
@@ -241,7 +241,7 @@ class IemdTracker:
         As in Algorithm 1 the appearance vectors are those of I_0; when Algorithm 2
         changes the dictionary they are only recoded.  Letting them follow the
         latest template instead was measured to drift (Car4/Bolt2/Woman mean
-        average overlap 15.0 % vs 26.1 %); blending the latest template into them
+        average overlap 15.0 % vs 26.1 %, with the defaults of the time); blending the latest template into them
         at a rate of 0.01, 0.03 or 0.1 per frame gave 27.6, 28.0 and 22.9 % against
         31.9 % over the 12 OTB sequences.
         """
@@ -268,14 +268,16 @@ class IemdTracker:
         With ``coarse_to_fine`` a first descent runs on templates sampled one
         pyramid level smoother, with kernel-only weights (no sparse coding, so it
         is cheap), and the full model refines from where it ends.  Measured
-        (benchmarks/tune_tracker.py, Car4/Bolt2/Woman average overlap): on 36.2 %,
-        off 34.9 % (it helps the panning Bolt2 and Woman, hurts the large Car4).
+        (benchmarks/tune_tracker.py, Car4/Bolt2/Woman average overlap, with the
+        defaults of the time): on 36.2 %, off 34.9 % (it helps the panning Bolt2 and Woman, hurts the large Car4).
         """
         if not self.config.coarse_to_fine:
-            return self._descend(pyramid, self._candidate(pyramid, center, size))
-        coarse = self._descend(pyramid, self._candidate(pyramid, center, size, coarse=True))
-        fine = self._descend(pyramid, self._candidate(pyramid, coarse.center, size))
-        fine.warnings += coarse.warnings
+            fine = self._descend(pyramid, self._candidate(pyramid, center, size))
+        else:
+            coarse = self._descend(pyramid, self._candidate(pyramid, center, size, coarse=True))
+            fine = self._descend(pyramid, self._candidate(pyramid, coarse.center, size))
+            fine.warnings += coarse.warnings
+        fine.codings += 1  # the start's model
         return fine
 
     def _particle_search(self, pyramid: ImagePyramid, starts: np.ndarray, size) -> _Descent:
@@ -296,7 +298,7 @@ class IemdTracker:
             warnings += _not_optimal(solution)
             scored.append((emd, model))
         best = self._descend(pyramid, min(scored, key=lambda item: item[0])[1])
-        best.codings += len(scored) - 1  # the winner's model is the descent's first
+        best.codings += len(scored)
         best.warnings += warnings
         return best
 
@@ -321,7 +323,7 @@ class IemdTracker:
         cfg = self.config
         size, coarse = model.size, bool(model.coarse)
         half = size / 2.0
-        c, s = np.cos(self._search_angle), np.sin(self._search_angle)
+        c, s = np.cos(model.angle), np.sin(model.angle)
         axes = np.array([[c, -s], [s, c]])  # window axes -> image axes
         emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
         state = _Descent(center=model.center, emd=emd,

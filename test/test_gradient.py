@@ -6,7 +6,7 @@ from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.candidate import CandidateModel
-from iemd_ros.emd import ground_distance, solve_emd
+from iemd_ros.emd import ground_distance, solve_emd, spatial_distance
 from iemd_ros.histogram import candidate_weights
 
 
@@ -36,10 +36,6 @@ def model_setup():
     return tracker, model
 
 
-def emd_at(model, y):
-    return model.evaluate("envelope", y)
-
-
 @pytest.mark.parametrize("y", [(0.0, 0.0), (0.05, -0.03)])
 def test_candidate_emd_uses_the_ground_distance(model_setup, y):
     """The model's compiled transport cost is eq. (ground distance) between the target bins and the
@@ -60,9 +56,9 @@ def test_candidate_emd_uses_the_ground_distance(model_setup, y):
 def test_envelope_gradient_matches_finite_differences(model_setup, y0):
     _, model = model_setup
     y0 = np.array(y0)
-    _, grad, _ = emd_at(model, y0)
+    _, grad, _ = model.evaluate("envelope", y0)
     h = 1e-6
-    fd = np.array([(emd_at(model, y0 + h * e)[0] - emd_at(model, y0 - h * e)[0]) / (2 * h)
+    fd = np.array([(model.emd(y0 + h * e)[0] - model.emd(y0 - h * e)[0]) / (2 * h)
                    for e in np.eye(2)])
     assert np.allclose(grad, fd, rtol=1e-3, atol=1e-6), (grad, fd)
 
@@ -81,8 +77,7 @@ def test_paper_gradient_is_the_derivative_through_the_weights_only(model_setup):
     keep = np.any([candidate_weights(model.code_weights, model.pos, y, cfg.kernel_bandwidth)[0] > 0
                    for y in [y0] + probes], axis=0)
     rel = model.pos[keep] - y0
-    cost = model.appearance_cost[:, keep] + (1 - cfg.alpha) * (
-        (target.pos[:, None, :] - rel[None, :, :]) ** 2).sum(-1)
+    cost = model.appearance_cost[:, keep] + (1 - cfg.alpha) * spatial_distance(target.pos, rel)
 
     def frozen_cost_emd(y):
         w, _ = candidate_weights(model.code_weights, model.pos, y, cfg.kernel_bandwidth)
