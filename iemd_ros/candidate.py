@@ -48,6 +48,11 @@ class TargetModel:
         return cls(pos=np.asarray(pos, dtype=np.float64)[keep], eps=np.asarray(eps, dtype=np.float64)[keep],
                    weights=weights[keep])
 
+    @cached_property
+    def eps_sq_norms(self) -> np.ndarray:
+        """||eps_u||^2 per bin, for the appearance distance of every candidate."""
+        return (self.eps**2).sum(1)
+
 
 class CandidateModel:
     """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``, against ``target``."""
@@ -75,7 +80,7 @@ class CandidateModel:
             self.code_weights = np.ones(len(self.eps))
         else:
             self.code_weights = max_alignment_pooling(coder.encode(self.eps.T), n_templates)
-        self.appearance_cost = alpha * appearance_distance(target.eps, self.eps)
+        self.appearance_cost = alpha * appearance_distance(target.eps, self.eps, target.eps_sq_norms)
         self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
 
     @cached_property

@@ -36,9 +36,14 @@ def ground_distance(eps_t, pos_t, eps_c, pos_c, alpha: float) -> np.ndarray:
     return alpha * appearance_distance(eps_t, eps_c) + (1.0 - alpha) * spatial_distance(pos_t, pos_c)
 
 
-def appearance_distance(eps_t, eps_c) -> np.ndarray:
-    """||eps_u - eps_v||^2 for all pairs (rows of ``eps_t`` x rows of ``eps_c``)."""
-    sq = (eps_t**2).sum(1)[:, None] + (eps_c**2).sum(1)[None, :] - 2.0 * eps_t @ eps_c.T
+def appearance_distance(eps_t, eps_c, sq_norms_t=None) -> np.ndarray:
+    """||eps_u - eps_v||^2 for all pairs (rows of ``eps_t`` x rows of ``eps_c``).
+
+    ``sq_norms_t``: the rows' squared norms of ``eps_t`` if already known (the target's, per candidate).
+    """
+    if sq_norms_t is None:
+        sq_norms_t = (eps_t**2).sum(1)
+    sq = sq_norms_t[:, None] + (eps_c**2).sum(1)[None, :] - 2.0 * eps_t @ eps_c.T
     return np.maximum(sq, 0.0)
 
 
