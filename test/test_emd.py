@@ -97,3 +97,18 @@ def test_ground_distance_terms_by_hand():
     assert np.allclose(appearance_distance(eps_t, eps_c), [[2.0, 0.0]])
     assert np.allclose(spatial_distance(pos_t, pos_c), [[0.25, 1.0]])
     assert np.allclose(ground_distance(eps_t, pos_t, eps_c, pos_c, 0.3), [[0.3 * 2 + 0.7 * 0.25, 0.7 * 1.0]])
+
+
+def test_duals_of_zero_weight_bins_stay_dual_feasible():
+    """The network simplex leaves the duals of empty bins arbitrary; solve_emd gives them the tightest
+    feasible values, so every reduced cost d_uv - u_u - v_v stays >= 0 (eq. 8's dual)."""
+    rng = np.random.default_rng(7)
+    w_t, w_c, cost = random_problem(rng, 12, 15)
+    w_t[[2, 7]], w_c[[0, 5, 9]] = 0.0, 0.0
+    w_t, w_c = w_t / w_t.sum(), w_c / w_c.sum()
+    sol = solve_emd(w_t, w_c, cost)
+    assert sol.optimal
+    reduced = cost - sol.u[:, None] - sol.v[None, :]
+    assert reduced.min() > -1e-10
+    assert np.isclose(reduced[[2, 7]].min(axis=1), 0.0, atol=1e-12).all()   # tightest: one reduced cost is 0
+    assert np.isclose(reduced[:, [0, 5, 9]].min(axis=0), 0.0, atol=1e-12).all()
