@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from iemd_ros.boxes import box_centre
+from iemd_ros.camera import CameraModel
 from iemd_ros.gyro import GyroConfig, GyroPredictor
 from iemd_ros.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
 from iemd_ros.synthetic import generate
@@ -154,6 +155,18 @@ def test_imu_before_camera_info_is_screened_and_held(seq):
     p.set_camera(seq.camera)
     d = p.diagnostics()
     assert (d["imu_pending"], d["imu_stored"]) == (0, 2)
+
+
+def test_set_camera_says_whether_the_camera_changed(seq):
+    p = _pipeline(seq)
+    cam = seq.camera
+    assert p.set_camera(cam) and p.camera is cam
+    assert not p.set_camera(cam)                   # the same object (a repeated, cached CameraInfo)
+    same = CameraModel(cam.K.copy(), cam.D.copy(), cam.width, cam.height)
+    assert not p.set_camera(same) and p.camera is cam
+    other = CameraModel(cam.K * [[1.1], [1.1], [1.0]], cam.D, cam.width, cam.height)
+    assert p.set_camera(other) and p.camera is other
+    assert p.diagnostics()["camera_infos"] == 4
 
 
 def test_frame_stamps_going_back_are_rejected_or_reset(seq):
