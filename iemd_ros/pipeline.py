@@ -538,8 +538,9 @@ class TrackingPipeline:
 
     def statuses(self, prefix: str = "iemd_tracker") -> list[Status]:
         """OK/WARN/ERROR summaries: tracking, image input, IMU/gyro, camera_info."""
-        d = self.diagnostics()
-        cfg = self._cfg
+        with self._lock:     # everything from one moment (RLock: diagnostics() takes it again)
+            d = self.diagnostics()
+            cfg, last, model = self._cfg, self._last_result, self._predictor.camera
         fmt = {k: (f"{v:.3f}" if isinstance(v, float) else str(v)) for k, v in d.items()}
 
         def vals(*keys):
@@ -581,7 +582,7 @@ class TrackingPipeline:
             imu = (WARN, "no IMU message received: tracking without the gyro prior")
         elif d["imu_bad_run"]:
             imu = (WARN, d["imu_reason"])
-        elif d["recent_processed"] and self._last_result is not None and not self._last_result.gyro_used:
+        elif d["recent_processed"] and last is not None and not last.gyro_used:
             imu = (WARN, f"latest frame tracked without the gyro prior: {d['gyro_reason']}")
         else:
             imu = (OK, f"gyro prior used on {d['recent_gyro_used']} of the last {d['recent_processed']} frames")
@@ -589,7 +590,7 @@ class TrackingPipeline:
                 "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status"]
         imu_status = Status(f"{prefix}: imu", *imu, vals(*keys))
         # camera_info
-        if self.camera is None:
+        if model is None:
             if d["camera_error"]:
                 cam = (ERROR, f"camera_info rejected: {d['camera_error']}")
             elif cfg.use_gyro:
