@@ -170,6 +170,11 @@ class FrameResult:
     def tracking(self) -> bool:
         return self.state == "tracking" and not self.rejected
 
+    @property
+    def is_init(self) -> bool:
+        """The result of the frame :meth:`TrackingPipeline.init` started on (``reason`` :data:`INIT_REASON`)."""
+        return self.reason == INIT_REASON
+
     def as_dict(self) -> dict:
         return asdict(self)
 

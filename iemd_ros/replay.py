@@ -55,7 +55,7 @@ from .camera import CameraModel
 from .cli import CliParser, cli_main
 from .conversions import camera_model_from_msg, detection_values, image_to_array, stamp_ns
 from .drawing import draw_result
-from .pipeline import INIT_REASON, FrameResult, PipelineConfig, TrackingPipeline
+from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
 
 __all__ = ["ReplayResult", "replay", "parse_box", "load_gt", "write_csv", "CSV_HEADER", "main"]
 
@@ -70,7 +70,7 @@ DETECTION_ID = "iemd"
 
 @dataclass
 class ReplayResult:
-    """Per-image results (the init frame's has ``reason == INIT_REASON``; frames skipped with
+    """Per-image results (the init frame's has ``is_init``; frames skipped with
     ``drop_stamps`` have none) and run statistics."""
 
     bag: str
@@ -129,13 +129,13 @@ def _fmt(v) -> str:
 def csv_rows(results: list[FrameResult]):
     for r in results:
         box = r.box if r.box is not None else (None,) * 4
-        if r.reason == INIT_REASON:
+        if r.is_init:
             state = "init"
         elif r.rejected:
             state = "malformed" if r.rejected.startswith("malformed") else "rejected"
         else:
             state = r.state
-        emd = None if r.reason == INIT_REASON or r.rejected else r.emd
+        emd = None if r.is_init or r.rejected else r.emd
         yield [str(int(r.stamp_ns)), *(_fmt(v) for v in box), _fmt(emd), state]
 
 

@@ -249,3 +249,10 @@ def test_input_problem_statuses(seq):
 def test_frame_result_defaults():
     r = FrameResult(5, "lost")
     assert not r.tracking and math.isnan(r.emd) and r.as_dict()["stamp_ns"] == 5
+
+
+def test_frame_result_is_init_marks_the_init_frame(seq):
+    p, s = _started(seq)
+    assert p.init(seq.frames[0], seq.gt_boxes[0], s[0]).is_init
+    assert not p.process(seq.frames[1], s[1]).is_init
+    assert FrameResult(5, "tracking", reason=INIT_REASON).is_init and not FrameResult(5, "tracking").is_init
