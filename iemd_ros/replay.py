@@ -110,9 +110,10 @@ class ReplayResult:
         return sum(r.gyro_used for r in self.results)
 
 
-def parse_box(text: str) -> tuple[float, float, float, float]:
-    """``"X,Y,W,H"`` -> 4 floats (finite, w, h > 0); ValueError otherwise."""
-    return check_box(str(text).split(","), "--init")
+def parse_box(box) -> tuple[float, float, float, float]:
+    """The init box: ``"X,Y,W,H"`` or a sequence of 4 numbers -> 4 floats (finite, w, h > 0); ValueError
+    (naming ``--init``) otherwise."""
+    return check_box(box.split(",") if isinstance(box, str) else box, "--init")
 
 
 def load_gt(path) -> np.ndarray:
@@ -240,7 +241,8 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
            camera_info_topic: str | None = None, config: PipelineConfig | None = None, use_gyro: bool = True,
            camera: CameraModel | None = None, csv_path=None, out_bag=None, video=None, progress: bool | None = None,
            warn=None, drop_stamps=()) -> ReplayResult:
-    """Replay ``bag`` through :class:`TrackingPipeline`, initialised with ``init_box`` on the first image.
+    """Replay ``bag`` through :class:`TrackingPipeline`, initialised with ``init_box`` on the first image
+    (``"X,Y,W,H"`` or 4 numbers, checked by :func:`parse_box`).
 
     ``config``: pipeline configuration (default ``PipelineConfig()``); ``use_gyro=False`` disables the
     prior (``--no-gyro``).  ``camera``: calibration to use instead of the bag's camera info.
@@ -250,7 +252,7 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
     on bad input; partial output files are removed then.
     """
     warn = warn if warn is not None else (lambda s: print(f"iemd-replay: warning: {s}", file=sys.stderr))
-    init_box = parse_box(init_box) if isinstance(init_box, str) else check_box(init_box, "--init")
+    init_box = parse_box(init_box)
     cfg = config if config is not None else PipelineConfig()
     warnings: list[str] = []
 
