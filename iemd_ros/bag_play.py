@@ -26,6 +26,7 @@ from pathlib import Path
 
 from .bag_io import BagError, Progress, iter_messages, open_bag, ros2_typestore
 from .cli import CliParser, cli_main
+from .conversions import ns_to_stamp
 
 
 @dataclass
@@ -144,7 +145,7 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
             late = (time.monotonic() - target) * 1e3
             if clock_pub is not None:
                 cm = Clock()
-                cm.clock.sec, cm.clock.nanosec = divmod(int(log_t), 1_000_000_000)
+                cm.clock.sec, cm.clock.nanosec = ns_to_stamp(log_t)
                 clock_pub.publish(cm)
             pubs[conn.topic].publish(msg)
             stats.published[conn.topic] = stats.published.get(conn.topic, 0) + 1

@@ -4,7 +4,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from .pipeline import INIT_REASON, FrameResult
+from .pipeline import FrameResult
 
 __all__ = ["draw_result"]
 
@@ -19,7 +19,7 @@ def draw_result(frame: np.ndarray, r: FrameResult) -> np.ndarray:
     if r.gyro_box is not None:
         _rect(img, r.gyro_box, GYRO, 1)
     if r.box is not None:
-        _rect(img, r.box, INIT if r.reason == INIT_REASON else TRACKING if r.tracking else LOST, 2)
+        _rect(img, r.box, INIT if r.is_init else TRACKING if r.tracking else LOST, 2)
     text = f"{r.stamp_ns / 1e9:.3f}s {_status(r)}"
     cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 3, cv2.LINE_AA)
     cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
@@ -27,7 +27,7 @@ def draw_result(frame: np.ndarray, r: FrameResult) -> np.ndarray:
 
 
 def _status(r: FrameResult) -> str:
-    if r.reason == INIT_REASON:
+    if r.is_init:
         return "initialized"
     if r.rejected or r.box is None:
         return r.rejected or r.state

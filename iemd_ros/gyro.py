@@ -34,7 +34,7 @@ import numpy as np
 
 from .boxes import centre_box, check_box
 from .camera import CameraModel
-from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
+from .imu import _ACCEPTED, Coverage, ImuBuffer, ImuIntegration
 from .rotation import GyroCalibration, StillBiasEstimator
 
 __all__ = ["rotation_homography", "warp_points", "box_grid", "local_prior", "predict_box",
@@ -250,7 +250,7 @@ class GyroPredictor:
         :class:`~iemd_ros.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
         status = self.buffer.add(t_ns, w)
         if not self.bias_estimator.done:
-            good = status == int(SampleStatus.ACCEPTED)
+            good = status == _ACCEPTED
             if good.any() and self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
         return status
@@ -293,8 +293,8 @@ class GyroPredictor:
 def compile_gyro_jit() -> None:
     """JIT-compile the gyro path's numba kernels now (or load them from numba's on-disk cache):
     the window integration and the lens undistortion.  In a fresh environment the first gyro
-    prediction otherwise stalls for ~2 s; a node or a replay calls this at start-up (with
-    :func:`iemd_ros.tracker.compile_jit`)."""
+    prediction otherwise stalls for ~2 s; :class:`iemd_ros.pipeline.TrackingPipeline` (node and
+    replay) calls this, with :func:`iemd_ros.tracker.compile_jit`, once per process at start-up."""
     predictor = GyroPredictor(CameraModel(np.diag([100.0, 100.0, 1.0]), [0.1, 0.0, 0.0, 0.0, 0.0], 64, 48))
     predictor.add_imu(np.array([0, 10_000_000, 20_000_000]), np.full((3, 3), 0.1))
     predictor.predict(2_000_000, 12_000_000, (16.0, 16.0, 16.0, 16.0))

@@ -48,8 +48,9 @@ class SampleStatus(IntEnum):
     SATURATED = 2                            # |w_i| >= saturation: rejected
 
 
-# The statuses as plain ints for the array code: numpy comparing an array with an IntEnum member
-# probes the enum class for array attributes, which doubled the cost of adding one IMU sample.
+# The statuses as plain ints for the array code (here and in gyro.GyroPredictor.add_imu): numpy
+# comparing an array with an IntEnum member probes the enum class for array attributes, which
+# doubled the cost of adding one IMU sample.
 _ACCEPTED, _NOT_FINITE, _SATURATED = (int(s) for s in SampleStatus)
 
 

@@ -41,6 +41,7 @@ from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithPose
 
 from .boxes import check_box
+from .cli import one_line
 from .conversions import (array_to_image_fields, bbox_to_box, camera_model_from_msg, detection_values,
                           image_to_array, stamp_ns)
 from .drawing import draw_result
@@ -501,7 +502,7 @@ def main(args=None) -> int:
     try:
         node = TrackerNode()
     except (ValueError, ParameterException) as exc:  # invalid parameters: one readable line, exit 2
-        print(f"{NODE_NAME}: invalid parameters: {exc}", file=sys.stderr)
+        print(f"{NODE_NAME}: invalid parameters: {one_line(exc)}", file=sys.stderr)
         rclpy.try_shutdown()
         return 2
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -28,6 +28,7 @@ other threads while :meth:`process` runs; they never wait for a tracker update t
 """
 from __future__ import annotations
 
+import functools
 import math
 import threading
 import time
@@ -141,10 +142,16 @@ class FrameResult:
     """Outcome of one frame.
 
     ``state``: "tracking", "lost" or "uninitialized"; ``rejected``: why the frame was not processed
-    ("" when it was).  ``box``/``emd``/``iterations``/``reason`` come from the tracker (``box`` is the
-    best window searched, also when lost); ``score`` = ``exp(-emd / score_emd_scale)`` while
-    tracking, else 0.  ``gyro_box``: the gyro's predicted window; ``predicted_box``: the tracker's
-    starting window (after the gyro prior).  ``processing_ms`` is wall-clock time.
+    ("" when it was).  ``box``/``angle``/``emd``/``iterations``/``reason`` come from the tracker
+    (:class:`~iemd_ros.tracker.TrackResult`; the best window searched, also when lost).  The tracked
+    window may be turned: ``angle`` is its orientation in radians -- its x axis points along
+    ``(cos angle, sin angle)`` in the image (y down); 0 when the tracker starts, then turned by each
+    gyro prior (the rotation part of the prior at the window: mostly the camera's roll), wrapped to
+    [-pi, pi) -- and ``box`` ``(x, y, w, h)`` is the axis-aligned bounding box of the window turned
+    by ``angle`` about its centre (the window's own size only when ``angle`` is 0).
+    ``score`` = ``exp(-emd / score_emd_scale)`` while tracking, else 0.  ``gyro_box``: the gyro's
+    predicted window; ``predicted_box``: the tracker's starting window (after the gyro prior; a
+    bounding box as ``box``).  ``processing_ms`` is wall-clock time.
     """
 
     stamp_ns: int
@@ -163,11 +170,16 @@ class FrameResult:
     scale: float = 1.0
     starts: int = 0
     processing_ms: float = 0.0
-    angle: float = 0.0  # orientation of the tracked window (radians); ``box`` is its bounding box
+    angle: float = 0.0  # orientation of the tracked window (radians); ``box`` is its bounding box (see above)
 
     @property
     def tracking(self) -> bool:
         return self.state == "tracking" and not self.rejected
+
+    @property
+    def is_init(self) -> bool:
+        """The result of the frame :meth:`TrackingPipeline.init` started on (``reason`` :data:`INIT_REASON`)."""
+        return self.reason == INIT_REASON
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -183,6 +195,15 @@ class Status:
     values: dict
 
 
+@functools.cache
+def _compile_jit_once() -> None:
+    """The tracker's and the gyro's JIT (:func:`~iemd_ros.tracker.compile_jit`,
+    :func:`~iemd_ros.gyro.compile_gyro_jit`), once per process: at the first pipeline's start-up, not
+    on the first frames; later pipelines (~7 ms of warm-up each otherwise) skip it."""
+    compile_jit()
+    compile_gyro_jit()
+
+
 def _ms(ns: float) -> str:
     return f"{ns / 1e6:.1f} ms"
 
@@ -191,8 +212,7 @@ class TrackingPipeline:
     """Tracker + gyro predictor fed message by message (see the module docstring)."""
 
     def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
-        compile_jit()  # the tracker's and the gyro's JIT: at start-up, not on the first frames
-        compile_gyro_jit()
+        _compile_jit_once()  # the JIT at the first start-up, not on the first frames
         self._cfg = config if config is not None else PipelineConfig()
         if not isinstance(self._cfg, PipelineConfig):
             raise ValueError("config must be a PipelineConfig")
@@ -266,6 +286,8 @@ class TrackingPipeline:
             self.counters["camera_infos"] += 1
             self._last["camera_error"] = ""
             cur = self._predictor.camera
+            if camera is cur:        # camera_model_from_msg is cached: a repeated CameraInfo gives the same object
+                return False
             if cur is not None and np.array_equal(cur.K, camera.K) and np.array_equal(cur.D, camera.D) \
                     and (cur.width, cur.height) == (camera.width, camera.height):
                 return False
@@ -527,8 +549,9 @@ class TrackingPipeline:
 
     def statuses(self, prefix: str = "iemd_tracker") -> list[Status]:
         """OK/WARN/ERROR summaries: tracking, image input, IMU/gyro, camera_info."""
-        d = self.diagnostics()
-        cfg = self._cfg
+        with self._lock:     # everything from one moment (RLock: diagnostics() takes it again)
+            d = self.diagnostics()
+            cfg, last, model = self._cfg, self._last_result, self._predictor.camera
         fmt = {k: (f"{v:.3f}" if isinstance(v, float) else str(v)) for k, v in d.items()}
 
         def vals(*keys):
@@ -570,7 +593,7 @@ class TrackingPipeline:
             imu = (WARN, "no IMU message received: tracking without the gyro prior")
         elif d["imu_bad_run"]:
             imu = (WARN, d["imu_reason"])
-        elif d["recent_processed"] and self._last_result is not None and not self._last_result.gyro_used:
+        elif d["recent_processed"] and last is not None and not last.gyro_used:
             imu = (WARN, f"latest frame tracked without the gyro prior: {d['gyro_reason']}")
         else:
             imu = (OK, f"gyro prior used on {d['recent_gyro_used']} of the last {d['recent_processed']} frames")
@@ -578,7 +601,7 @@ class TrackingPipeline:
                 "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status"]
         imu_status = Status(f"{prefix}: imu", *imu, vals(*keys))
         # camera_info
-        if self.camera is None:
+        if model is None:
             if d["camera_error"]:
                 cam = (ERROR, f"camera_info rejected: {d['camera_error']}")
             elif cfg.use_gyro:

@@ -55,7 +55,7 @@ from .camera import CameraModel
 from .cli import CliParser, cli_main
 from .conversions import camera_model_from_msg, detection_values, image_to_array, stamp_ns
 from .drawing import draw_result
-from .pipeline import INIT_REASON, FrameResult, PipelineConfig, TrackingPipeline
+from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
 
 __all__ = ["ReplayResult", "replay", "parse_box", "load_gt", "write_csv", "CSV_HEADER", "main"]
 
@@ -70,7 +70,7 @@ DETECTION_ID = "iemd"
 
 @dataclass
 class ReplayResult:
-    """Per-image results (the init frame's has ``reason == INIT_REASON``; frames skipped with
+    """Per-image results (the init frame's has ``is_init``; frames skipped with
     ``drop_stamps`` have none) and run statistics."""
 
     bag: str
@@ -110,9 +110,10 @@ class ReplayResult:
         return sum(r.gyro_used for r in self.results)
 
 
-def parse_box(text: str) -> tuple[float, float, float, float]:
-    """``"X,Y,W,H"`` -> 4 floats (finite, w, h > 0); ValueError otherwise."""
-    return check_box(str(text).split(","), "--init")
+def parse_box(box) -> tuple[float, float, float, float]:
+    """The init box: ``"X,Y,W,H"`` or a sequence of 4 numbers -> 4 floats (finite, w, h > 0); ValueError
+    (naming ``--init``) otherwise."""
+    return check_box(box.split(",") if isinstance(box, str) else box, "--init")
 
 
 def load_gt(path) -> np.ndarray:
@@ -129,13 +130,13 @@ def _fmt(v) -> str:
 def csv_rows(results: list[FrameResult]):
     for r in results:
         box = r.box if r.box is not None else (None,) * 4
-        if r.reason == INIT_REASON:
+        if r.is_init:
             state = "init"
         elif r.rejected:
             state = "malformed" if r.rejected.startswith("malformed") else "rejected"
         else:
             state = r.state
-        emd = None if r.reason == INIT_REASON or r.rejected else r.emd
+        emd = None if r.is_init or r.rejected else r.emd
         yield [str(int(r.stamp_ns)), *(_fmt(v) for v in box), _fmt(emd), state]
 
 
@@ -240,7 +241,8 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
            camera_info_topic: str | None = None, config: PipelineConfig | None = None, use_gyro: bool = True,
            camera: CameraModel | None = None, csv_path=None, out_bag=None, video=None, progress: bool | None = None,
            warn=None, drop_stamps=()) -> ReplayResult:
-    """Replay ``bag`` through :class:`TrackingPipeline`, initialised with ``init_box`` on the first image.
+    """Replay ``bag`` through :class:`TrackingPipeline`, initialised with ``init_box`` on the first image
+    (``"X,Y,W,H"`` or 4 numbers, checked by :func:`parse_box`).
 
     ``config``: pipeline configuration (default ``PipelineConfig()``); ``use_gyro=False`` disables the
     prior (``--no-gyro``).  ``camera``: calibration to use instead of the bag's camera info.
@@ -250,7 +252,7 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
     on bad input; partial output files are removed then.
     """
     warn = warn if warn is not None else (lambda s: print(f"iemd-replay: warning: {s}", file=sys.stderr))
-    init_box = parse_box(init_box) if isinstance(init_box, str) else check_box(init_box, "--init")
+    init_box = parse_box(init_box)
     cfg = config if config is not None else PipelineConfig()
     warnings: list[str] = []
 

@@ -379,8 +379,10 @@ class IemdTracker:
 def compile_jit() -> None:
     """JIT-compile the tracker's numba kernels now (or load them from numba's on-disk cache).
 
-    The first call in a fresh environment compiles for seconds; a node or a
-    replay calls this at start-up so the first frames are not dropped for it.
+    The first call in a fresh environment compiles for seconds;
+    :class:`iemd_ros.pipeline.TrackingPipeline` (node and replay) calls this, with
+    :func:`iemd_ros.gyro.compile_gyro_jit`, once per process at start-up so the first frames are not
+    dropped for it.
     """
     frame = (np.random.default_rng(0).random((64, 64)) * 255).astype(np.uint8)
     tracker = IemdTracker()

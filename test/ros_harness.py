@@ -23,6 +23,15 @@ from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp
 FRAME_ID = "synthetic_cam"
 
 
+def imu_msg(t_ns: int, w) -> Imu:
+    """A sensor_msgs/Imu stamped ``t_ns`` (frame "imu") with angular velocity ``w`` (3 values, rad/s)."""
+    msg = Imu()
+    msg.header.frame_id = "imu"
+    msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+    msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in w)
+    return msg
+
+
 @contextmanager
 def isolated_ros_env():
     """A random ROS_DOMAIN_ID in 30..99 and localhost-only discovery (restored afterwards)."""
@@ -121,11 +130,7 @@ class Driver:
         self.image_pub.publish(msg)
 
     def publish_imu(self, t_ns: int, w) -> None:
-        msg = Imu()
-        msg.header.frame_id = "imu"
-        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
-        msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in w)
-        self.imu_pub.publish(msg)
+        self.imu_pub.publish(imu_msg(t_ns, w))
 
     def publish_camera_info(self, seq, k=None) -> None:
         msg = CameraInfo()

@@ -11,7 +11,7 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
-from ros_harness import FRAME_ID, Driver, level, spinning, values  # noqa: E402
+from ros_harness import FRAME_ID, Driver, imu_msg, level, spinning, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
 
@@ -236,19 +236,13 @@ def test_malformed_input_keeps_the_node_alive_and_explains(ctx, seq):
 
 
 def test_imu_wakes_the_worker_only_for_the_frame_it_holds(ctx, seq):
-    from sensor_msgs.msg import Imu
-
-    from iemd_ros.conversions import ns_to_stamp
-
     node = TrackerNode(context=ctx, parameter_overrides=[Parameter("gyro.time_offset_ns", value=4_000_000)])
     try:
         wakes, notify = [], node._cond.notify_all
         node._cond.notify_all = lambda: (wakes.append(1), notify())
 
         def imu(t_ns):
-            msg = Imu()
-            msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(int(t_ns))
-            node._on_imu(msg)
+            node._on_imu(imu_msg(t_ns, (0.0, 0.0, 0.0)))
 
         s = [int(v) for v in seq.frame_stamps_ns]
         node.pipeline.set_camera(seq.camera)

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from iemd_ros.boxes import box_centre
+from iemd_ros.camera import CameraModel
 from iemd_ros.gyro import GyroConfig, GyroPredictor
 from iemd_ros.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
 from iemd_ros.synthetic import generate
@@ -156,6 +157,18 @@ def test_imu_before_camera_info_is_screened_and_held(seq):
     assert (d["imu_pending"], d["imu_stored"]) == (0, 2)
 
 
+def test_set_camera_says_whether_the_camera_changed(seq):
+    p = _pipeline(seq)
+    cam = seq.camera
+    assert p.set_camera(cam) and p.camera is cam
+    assert not p.set_camera(cam)                   # the same object (a repeated, cached CameraInfo)
+    same = CameraModel(cam.K.copy(), cam.D.copy(), cam.width, cam.height)
+    assert not p.set_camera(same) and p.camera is cam
+    other = CameraModel(cam.K * [[1.1], [1.1], [1.0]], cam.D, cam.width, cam.height)
+    assert p.set_camera(other) and p.camera is other
+    assert p.diagnostics()["camera_infos"] == 4
+
+
 def test_frame_stamps_going_back_are_rejected_or_reset(seq):
     p, s = _started(seq)
     assert p.process(seq.frames[2], s[2]).tracking
@@ -236,3 +249,10 @@ def test_input_problem_statuses(seq):
 def test_frame_result_defaults():
     r = FrameResult(5, "lost")
     assert not r.tracking and math.isnan(r.emd) and r.as_dict()["stamp_ns"] == 5
+
+
+def test_frame_result_is_init_marks_the_init_frame(seq):
+    p, s = _started(seq)
+    assert p.init(seq.frames[0], seq.gt_boxes[0], s[0]).is_init
+    assert not p.process(seq.frames[1], s[1]).is_init
+    assert FrameResult(5, "tracking", reason=INIT_REASON).is_init and not FrameResult(5, "tracking").is_init

@@ -16,7 +16,7 @@ from iemd_ros.bag_io import BagWriter, header
 from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag, write_gt
 from iemd_ros.conversions import bbox_to_box
 from iemd_ros.metrics import iou, score_sequence
-from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, replay
+from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
 
 REPO = Path(__file__).resolve().parents[1]
 N = 10
@@ -284,3 +284,14 @@ def test_imu_wait_is_bag_time(seq, tmp_path):
     long = replay(tmp_path / "late", seq.gt_boxes[0], config=PipelineConfig(imu_wait_ms=100.0))
     assert short.gyro_used == 0 and long.gyro_used == N - 1
     assert "not covering" in short.results[-1].gyro_reason
+
+
+def test_parse_box_takes_a_string_or_a_sequence():
+    assert parse_box("1,2.5,3,4") == parse_box([1, 2.5, 3, 4]) == parse_box(np.array([1, 2.5, 3, 4])) \
+        == (1.0, 2.5, 3.0, 4.0)
+    with pytest.raises(ValueError, match="--init must be 4 numbers"):
+        parse_box("1,2,3")
+    with pytest.raises(ValueError, match="--init must have a positive size"):
+        parse_box((1, 2, 0, 4))
+    with pytest.raises(ValueError, match="--init has non-finite values"):
+        parse_box([1, 2, float("nan"), 4])
