@@ -143,12 +143,9 @@ class FrameResult:
 
     ``state``: "tracking", "lost" or "uninitialized"; ``rejected``: why the frame was not processed
     ("" when it was).  ``box``/``angle``/``emd``/``iterations``/``reason`` come from the tracker
-    (:class:`~iemd_ros.tracker.TrackResult`; the best window searched, also when lost).  The tracked
-    window may be turned: ``angle`` is its orientation in radians -- its x axis points along
-    ``(cos angle, sin angle)`` in the image (y down); 0 when the tracker starts, then turned by each
-    gyro prior (the rotation part of the prior at the window: mostly the camera's roll), wrapped to
-    [-pi, pi) -- and ``box`` ``(x, y, w, h)`` is the axis-aligned bounding box of the window turned
-    by ``angle`` about its centre (the window's own size only when ``angle`` is 0).
+    (:class:`~iemd_ros.tracker.TrackResult`; the best window searched, also when lost): ``angle``
+    (radians) is the window's turn, which the gyro priors change (mostly the camera's roll), and
+    ``box`` ``(x, y, w, h)`` the axis-aligned bounding box of the turned window.
     ``score`` = ``exp(-emd / score_emd_scale)`` while tracking, else 0.  ``gyro_box``: the gyro's
     predicted window; ``predicted_box``: the tracker's starting window (after the gyro prior; a
     bounding box as ``box``).  ``processing_ms`` is wall-clock time.
@@ -170,7 +167,7 @@ class FrameResult:
     scale: float = 1.0
     starts: int = 0
     processing_ms: float = 0.0
-    angle: float = 0.0  # orientation of the tracked window (radians); ``box`` is its bounding box (see above)
+    angle: float = 0.0
 
     @property
     def tracking(self) -> bool:
