@@ -190,17 +190,22 @@ class ImuBuffer:
         self._pend_t, self._pend_w, self._n_pend = [], [], 0
         t, w = np.concatenate([self._t, pt]), np.concatenate([self._w, pw])
         n = np.concatenate([self._n, np.ones(len(pt))])
-        # usually all pending samples are newer than the store: only they are sorted, then appended;
-        # reaching back into it, one stable sort of it all (the store first, arrivals in order)
-        lo = 0 if len(self._t) and pt.min() <= self._t[-1] else len(self._t)
+        # the store (sorted, stamps unique) below the earliest arrival stays as it is: only the tail
+        # from there is sorted, stably (the store first, arrivals in order) - usually just the
+        # arrivals, appended - and only the tail can repeat a stamp (t[lo] > t[lo - 1])
+        lo = int(np.searchsorted(self._t, pt.min(), "left"))
         order = np.argsort(t[lo:], kind="stable")
         t[lo:], w[lo:], n[lo:] = t[lo:][order], w[lo:][order], n[lo:][order]
-        start = np.flatnonzero(np.concatenate([[True], t[1:] != t[:-1]]))  # first of each stamp (t sorted)
-        if len(start) < len(t):
-            self.counts["duplicates"] += len(t) - len(start)
-            nn = np.add.reduceat(n, start)
-            w = np.add.reduceat(w * n[:, None], start, axis=0) / nn[:, None]
-            t, n = t[start], nn
+        tt = t[lo:]
+        start = np.flatnonzero(np.concatenate([[True], tt[1:] != tt[:-1]]))  # first of each stamp
+        if len(start) < len(tt):
+            self.counts["duplicates"] += len(tt) - len(start)
+            nn = np.add.reduceat(n[lo:], start)
+            wt = np.add.reduceat(w[lo:] * n[lo:, None], start, axis=0) / nn[:, None]
+            # the store below lo, each entry its own group, gets w * n / n as from a mean over the
+            # whole store: w in practice, not always (w * 3 overflows near the largest double)
+            wh = w[:lo] * n[:lo, None] / n[:lo, None]
+            t, w, n = np.concatenate([t[:lo], tt[start]]), np.concatenate([wh, wt]), np.concatenate([n[:lo], nn])
         keep_from = max(len(t) - self.max_samples, int(np.searchsorted(t, t[-1] - self.max_duration_ns)))
         self.counts["dropped"] += keep_from
         self._t, self._w, self._n = t[keep_from:], w[keep_from:], n[keep_from:]
