@@ -243,9 +243,10 @@ class ImuBuffer:
                   coning: bool = True) -> ImuIntegration:
         """Integrate the rate over ``[t0_ns, t1_ns]`` (IMU clock) into the rotation of ``t1`` in ``t0``.
 
-        Rates are interpolated linearly at both ends, then integrated exactly
-        (:func:`iemd_ros.rotation.integrate_rates`).  With a ``calibration`` the bias is removed and
-        the rotation is expressed in the camera frame: ``R_cam = R_cam_imu R R_cam_imu^T``.
+        Rates are interpolated linearly at both ends, then integrated exactly by ``_window_rotation``
+        (one compiled pass through :func:`iemd_ros.rotation.magnus_product`, the core of
+        :func:`iemd_ros.rotation.integrate_rates`: the same maths).  With a ``calibration`` the bias is
+        removed and the rotation is expressed in the camera frame: ``R_cam = R_cam_imu R R_cam_imu^T``.
         """
         t0, t1 = int(t0_ns), int(t1_ns)
         if t1 < t0:
@@ -273,7 +274,6 @@ class ImuBuffer:
         max_gap = int(np.diff(ts).max()) if n_used > 1 else 0
         if t1 == t0:
             return _identity(t0, t1, Coverage.OK, "empty window", n_used, max_gap)
-        # knots: t0, the samples strictly inside, t1 (rates interpolated at the ends)
         q_imu = _window_rotation((ts - t0).astype(float) * 1e-9, ws, (t1 - t0) * 1e-9,
                                  coning)
         R = cal.R_cam_imu @ quat_to_rot(q_imu) @ cal.R_cam_imu.T
