@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from iemd_ros import TrackerConfig
 from iemd_ros.metrics import score_sequence
 from iemd_ros.recordings import load_recording, track_recording
 
@@ -29,8 +30,6 @@ DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / 
 
 def run(rec, start: int, stop: int, use_gyro: bool, scale_range: float):
     """Tracker boxes for frames start..stop-1 (the init frame gets its GT box), lost count, prior notes."""
-    from iemd_ros import TrackerConfig
-
     results, no_prior = track_recording(rec, start, stop, use_gyro, TrackerConfig(scale_range=scale_range))
     boxes = [np.asarray(rec.gt_boxes[start], float)] + [np.asarray(r.box, float) for r in results]
     return np.array(boxes), sum(r.lost for r in results), no_prior

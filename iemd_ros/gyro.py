@@ -228,7 +228,8 @@ class GyroPredictor:
     new frame yet, the result has ``status == not_covered`` and no prior: wait a bounded time
     (:meth:`ready`) and call again, or go on without the prior and log ``reason``.  ``camera`` may be
     None until the calibration is known (set it then): samples are buffered, :meth:`predict` needs it.
-    ``config`` is valid by construction (:class:`GyroConfig` checks itself).
+    ``config`` is not checked again here: :class:`GyroConfig` checks its fields when it is built
+    (``__post_init__``); it is a mutable dataclass, so fields changed afterwards go unchecked.
     """
 
     def __init__(self, camera: CameraModel | None, config: GyroConfig | None = None):

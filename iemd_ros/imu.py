@@ -191,17 +191,22 @@ class ImuBuffer:
         self._pend_t, self._pend_w, self._n_pend = [], [], 0
         t, w = np.concatenate([self._t, pt]), np.concatenate([self._w, pw])
         n = np.concatenate([self._n, np.ones(len(pt))])
-        # usually all pending samples are newer than the store: only they are sorted, then appended;
-        # reaching back into it, one stable sort of it all (the store first, arrivals in order)
-        lo = 0 if len(self._t) and pt.min() <= self._t[-1] else len(self._t)
+        # the store (sorted, stamps unique) below the earliest arrival stays as it is: only the tail
+        # from there is sorted, stably (the store first, arrivals in order) - usually just the
+        # arrivals, appended - and only the tail can repeat a stamp (t[lo] > t[lo - 1])
+        lo = int(np.searchsorted(self._t, pt.min(), "left"))
         order = np.argsort(t[lo:], kind="stable")
         t[lo:], w[lo:], n[lo:] = t[lo:][order], w[lo:][order], n[lo:][order]
-        start = np.flatnonzero(np.concatenate([[True], t[1:] != t[:-1]]))  # first of each stamp (t sorted)
-        if len(start) < len(t):
-            self.counts["duplicates"] += len(t) - len(start)
-            nn = np.add.reduceat(n, start)
-            w = np.add.reduceat(w * n[:, None], start, axis=0) / nn[:, None]
-            t, n = t[start], nn
+        tt = t[lo:]
+        start = np.flatnonzero(np.concatenate([[True], tt[1:] != tt[:-1]]))  # first of each stamp
+        if len(start) < len(tt):
+            self.counts["duplicates"] += len(tt) - len(start)
+            nn = np.add.reduceat(n[lo:], start)
+            wt = np.add.reduceat(w[lo:] * n[lo:, None], start, axis=0) / nn[:, None]
+            # the store below lo, each entry its own group, gets w * n / n as from a mean over the
+            # whole store: w in practice, not always (w * 3 overflows near the largest double)
+            wh = w[:lo] * n[:lo, None] / n[:lo, None]
+            t, w, n = np.concatenate([t[:lo], tt[start]]), np.concatenate([wh, wt]), np.concatenate([n[:lo], nn])
         keep_from = max(len(t) - self.max_samples, int(np.searchsorted(t, t[-1] - self.max_duration_ns)))
         self.counts["dropped"] += keep_from
         self._t, self._w, self._n = t[keep_from:], w[keep_from:], n[keep_from:]
@@ -239,9 +244,10 @@ class ImuBuffer:
                   coning: bool = True) -> ImuIntegration:
         """Integrate the rate over ``[t0_ns, t1_ns]`` (IMU clock) into the rotation of ``t1`` in ``t0``.
 
-        Rates are interpolated linearly at both ends, then integrated exactly
-        (:func:`iemd_ros.rotation.integrate_rates`).  With a ``calibration`` the bias is removed and
-        the rotation is expressed in the camera frame: ``R_cam = R_cam_imu R R_cam_imu^T``.
+        Rates are interpolated linearly at both ends, then integrated exactly by ``_window_rotation``
+        (one compiled pass through :func:`iemd_ros.rotation.magnus_product`, the core of
+        :func:`iemd_ros.rotation.integrate_rates`: the same maths).  With a ``calibration`` the bias is
+        removed and the rotation is expressed in the camera frame: ``R_cam = R_cam_imu R R_cam_imu^T``.
         """
         t0, t1 = int(t0_ns), int(t1_ns)
         if t1 < t0:
@@ -269,7 +275,6 @@ class ImuBuffer:
         max_gap = int(np.diff(ts).max()) if n_used > 1 else 0
         if t1 == t0:
             return _identity(t0, t1, Coverage.OK, "empty window", n_used, max_gap)
-        # knots: t0, the samples strictly inside, t1 (rates interpolated at the ends)
         q_imu = _window_rotation((ts - t0).astype(float) * 1e-9, ws, (t1 - t0) * 1e-9,
                                  coning)
         R = cal.R_cam_imu @ quat_to_rot(q_imu) @ cal.R_cam_imu.T

@@ -8,6 +8,7 @@ from iemd_ros.camera import CameraModel
 DESK = dict(image_width=640, image_height=480,
             camera_matrix=dict(rows=3, cols=3, data=[570.246, -0.100721, 309.408, 0, 569.324, 217.996, 0, 0, 1]),
             distortion_model="plumb_bob", distortion_coefficients=dict(rows=1, cols=5, data=[-0.346217, 0.128289, 0, 0, 0]))
+DESK_K = np.reshape(DESK["camera_matrix"]["data"], (3, 3))
 
 
 def grid(w, h, step=4):
@@ -40,6 +41,18 @@ def test_undistort_points_agrees_with_opencv_when_there_is_no_skew():
     # OpenCV's default (5 fixed-point iterations) is not accurate enough at the corners
     ocv5 = cv2.undistortPoints(raw[:, None, :], K, D, P=K)[:, 0]
     assert np.abs(cam.distort_points(ocv5) - raw).max() > 0.01
+
+
+def test_undistort_points_is_nan_where_the_lens_is_not_invertible():
+    # r_d = r (1 - 0.6 r^2) peaks at r_d ~ 0.497 (283 px): beyond it no undistorted point maps there
+    cam = CameraModel(DESK_K, [-0.6, 0, 0, 0, 0], 640, 480)
+    c = cam.K[:2, 2]
+    raw = np.array([c + [100.0, 0.0], c + [400.0, 0.0], c + [0.0, -150.0], c + [300.0, 300.0], [np.nan, 5.0]])
+    und = cam.undistort_points(raw)
+    assert np.isnan(und[[1, 3, 4]]).all()
+    assert np.isfinite(und[[0, 2]]).all()
+    assert np.abs(cam.distort_points(und[[0, 2]]) - raw[[0, 2]]).max() < 1e-6
+    assert cam.undistort_points(raw.reshape(5, 1, 2)).shape == (5, 1, 2)
 
 
 def test_skew_is_honoured():

@@ -107,6 +107,20 @@ def test_later_batches_reaching_back_into_the_store_or_appended():
     assert (st["duplicates"], st["out_of_order"], st["stored"]) == (4, 7, 10)
 
 
+def test_arrivals_on_the_first_or_last_stored_stamp_are_merged_into_it():
+    buf = ImuBuffer()
+    buf.add(T0 + np.array([0, 10, 20]) * MS, [[1, 0, 0], [2, 0, 0], [3, 0, 0]])
+    assert len(buf) == 3
+    buf.add(T0 + np.array([20, 30]) * MS, [[5, 0, 0], [7, 0, 0]])           # on the newest stored stamp
+    assert len(buf) == 4
+    buf.add(T0 + np.array([15, 0, 0]) * MS, [[4, 0, 0], [2, 0, 0], [6, 0, 0]])  # on the oldest, twice
+    t, w = buf.samples()
+    assert list((t - T0) // MS) == [0, 10, 15, 20, 30]
+    np.testing.assert_array_equal(w[:, 0], [3, 2, 4, 4, 7])
+    st = buf.stats()
+    assert (st["duplicates"], st["out_of_order"], st["stored"]) == (3, 3, 5)
+
+
 def test_clock_stepping_back_like_the_cmu_desk_log():
     """Rows 77139, 77169, 77159, 77169, 77179 ms (the desk pattern) are put in order and counted."""
     t_ms = np.array([77119, 77129, 77139, 77169, 77159, 77169, 77179, 77189])

@@ -49,6 +49,22 @@ def test_parse_groundtruth_errors_name_file_and_line(tmp_path, text, match):
         parse_groundtruth(path)
 
 
+def test_gt_file_parsing(tmp_path):
+    p = tmp_path / "gt.txt"
+    p.write_text("10,20,30,40,ok\nNaN,NaN,NaN,NaN,absent\n1.5,2,3,4\n5,6,7,8,absent\n")
+    boxes, flags = parse_groundtruth(p, with_flags=True)
+    np.testing.assert_allclose(boxes[0], [9, 19, 30, 40])
+    assert np.isnan(boxes[1]).all() and np.isnan(boxes[3]).all()
+    np.testing.assert_allclose(boxes[2], [0.5, 1, 3, 4])
+    assert list(flags) == ["ok", "absent", "ok", "absent"]
+    p.write_text("1,2,x,4\n")
+    with pytest.raises(ValueError, match="bad box line"):
+        parse_groundtruth(p, with_flags=True)
+    p.write_text("1 2 3 4 blur\n1,2,3,4,5,6\n")
+    with pytest.raises(ValueError, match=r"gt\.txt:2: expected 4 values x,y,w,h and an optional flag, got 6"):
+        parse_groundtruth(p, with_flags=True)
+
+
 def _make_seq(folder: Path, numbers, gts: dict[str, str], gray=False) -> Path:
     (folder / "img").mkdir(parents=True)
     for k, n in enumerate(numbers):

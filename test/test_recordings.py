@@ -1,8 +1,7 @@
-"""Loaders of the real recordings (CMU desk/aerial, phone) and of OTB-style ground-truth files."""
+"""Loaders of the real recordings (CMU desk/aerial, phone)."""
 import numpy as np
 import pytest
 
-from iemd_ros.otb import parse_groundtruth
 from iemd_ros.recordings import CMU_TIME_OFFSET_NS, load_recording
 
 
@@ -32,22 +31,6 @@ def test_cmu_aerial_and_phone(imu_root):
     assert phone.imu_t_ns[0] == 4_328_040_426_741_000
     assert phone.time_offset_ns == 13_000_000 and not phone.camera.has_distortion
     assert phone.gyro.shape == (29466, 3)
-
-
-def test_gt_file_parsing(tmp_path):
-    p = tmp_path / "gt.txt"
-    p.write_text("10,20,30,40,ok\nNaN,NaN,NaN,NaN,absent\n1.5,2,3,4\n5,6,7,8,absent\n")
-    boxes, flags = parse_groundtruth(p, with_flags=True)
-    np.testing.assert_allclose(boxes[0], [9, 19, 30, 40])
-    assert np.isnan(boxes[1]).all() and np.isnan(boxes[3]).all()
-    np.testing.assert_allclose(boxes[2], [0.5, 1, 3, 4])
-    assert list(flags) == ["ok", "absent", "ok", "absent"]
-    p.write_text("1,2,x,4\n")
-    with pytest.raises(ValueError, match="bad box line"):
-        parse_groundtruth(p, with_flags=True)
-    p.write_text("1 2 3 4 blur\n1,2,3,4,5,6\n")
-    with pytest.raises(ValueError, match=r"gt\.txt:2: expected 4 values x,y,w,h and an optional flag, got 6"):
-        parse_groundtruth(p, with_flags=True)
 
 
 def test_bad_folder(tmp_path):
