@@ -203,10 +203,7 @@ class ImuBuffer:
             self.counts["duplicates"] += len(tt) - len(start)
             nn = np.add.reduceat(n[lo:], start)
             wt = np.add.reduceat(w[lo:] * n[lo:, None], start, axis=0) / nn[:, None]
-            # the store below lo, each entry its own group, gets w * n / n as from a mean over the
-            # whole store: w in practice, not always (w * 3 overflows near the largest double)
-            wh = w[:lo] * n[:lo, None] / n[:lo, None]
-            t, w, n = np.concatenate([t[:lo], tt[start]]), np.concatenate([wh, wt]), np.concatenate([n[:lo], nn])
+            t, w, n = np.concatenate([t[:lo], tt[start]]), np.concatenate([w[:lo], wt]), np.concatenate([n[:lo], nn])
         keep_from = max(len(t) - self.max_samples, int(np.searchsorted(t, t[-1] - self.max_duration_ns)))
         self.counts["dropped"] += keep_from
         self._t, self._w, self._n = t[keep_from:], w[keep_from:], n[keep_from:]
