@@ -22,7 +22,7 @@ from .boxes import box_centre, centre_box, check_box
 
 __all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "camera_model_from_info", "camera_model_from_msg",
            "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
-           "DetectionValues", "detection_values"]
+           "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
 
 # encoding -> (channels, bytes per channel)
 ENCODINGS = {"mono8": (1, 1), "mono16": (1, 2), "bgr8": (3, 1), "rgb8": (3, 1), "bgra8": (4, 1), "rgba8": (4, 1)}
@@ -166,6 +166,10 @@ def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) 
     """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size."""
     box = centre_box([center_x, center_y], [size_x, size_y])
     return check_box(box, f"bounding box (centre ({center_x}, {center_y}), size {size_x} x {size_y})")
+
+
+CLASS_ID = "target"  # default class_id of the published hypothesis (node parameter ``class_id``)
+DETECTION_ID = "iemd"  # default id of the published Detection2D (node parameter ``detection_id``)
 
 
 class DetectionValues(NamedTuple):

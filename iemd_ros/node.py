@@ -42,8 +42,8 @@ from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithP
 
 from .boxes import check_box
 from .cli import one_line
-from .conversions import (array_to_image_fields, bbox_to_box, camera_model_from_msg, detection_values,
-                          image_to_array, stamp_ns)
+from .conversions import (CLASS_ID, DETECTION_ID, array_to_image_fields, bbox_to_box, camera_model_from_msg,
+                          detection_values, image_to_array, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
 from .pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
@@ -208,8 +208,8 @@ class TrackerNode(Node):
                                          (0.0, 10_000.0)), False),
             ("diagnostics_period_s", 1.0, ("period of /diagnostics, s", (0.01, 60.0)), True),
             ("input_timeout_s", 2.0, ("warn when no image / IMU arrived for this long, s", (0.01, 3600.0)), False),
-            ("class_id", "target", ("class_id of the published hypothesis", None), False),
-            ("detection_id", "iemd", ("id of the published Detection2D", None), False),
+            ("class_id", CLASS_ID, ("class_id of the published hypothesis", None), False),
+            ("detection_id", DETECTION_ID, ("id of the published Detection2D", None), False),
         ]
         for name, value, doc, read_only in node_params:
             self._declare(name, value, _descriptor(name, doc, value, read_only))

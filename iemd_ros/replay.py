@@ -53,7 +53,7 @@ from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Pro
 from .boxes import check_box
 from .camera import CameraModel
 from .cli import CliParser, cli_main
-from .conversions import camera_model_from_msg, detection_values, image_to_array, stamp_ns
+from .conversions import CLASS_ID, DETECTION_ID, camera_model_from_msg, detection_values, image_to_array, stamp_ns
 from .drawing import draw_result
 from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
 
@@ -64,8 +64,6 @@ CSV_HEADER = ("stamp_ns", "x", "y", "w", "h", "emd", "state")
 # "target", id "iemd"; one detection while tracking, none when lost; the init frame has score 1)
 DETECTIONS_TOPIC = "/detections"
 DIAGNOSTICS_TOPIC = "/diagnostics"
-CLASS_ID = "target"
-DETECTION_ID = "iemd"
 
 
 @dataclass
