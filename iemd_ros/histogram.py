@@ -14,7 +14,7 @@ largest code to name where the patch sits in the target.  Measured
 step of their place, on later frames 27.6 %; the lowest EMD on a +-0.4 window
 grid lies 0.230 window sizes from the truth against 0.197 for per-patch bins.
 A prototype tracker on the votes (kernel moving over fixed dense patches, not
-kept) scored 6-14 % average overlap on Car4/Bolt2/Woman.
+kept) scored 2.7-14.1 % average overlap on Car4/Bolt2/Woman.
 
 Bandwidth choice (the paper only says "h is template size"): positions are in
 normalized window units (the window is [-1, 1]^2).  The tracker's default is
