@@ -163,9 +163,13 @@ def box_to_bbox(box) -> tuple[float, float, float, float]:
 
 
 def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) -> tuple[float, float, float, float]:
-    """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size."""
-    box = centre_box([center_x, center_y], [size_x, size_y])
-    return check_box(box, f"bounding box (centre ({center_x}, {center_y}), size {size_x} x {size_y})")
+    """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size.
+
+    The values are checked as given (``check_box``'s last two are the sizes), so the
+    message shows what the sender wrote, not the corner box derived from it.
+    """
+    cx, cy, sx, sy = check_box((center_x, center_y, size_x, size_y), "bounding box (center_x, center_y, size_x, size_y)")
+    return tuple(float(v) for v in centre_box((cx, cy), (sx, sy)))
 
 
 CLASS_ID = "target"  # default class_id of the published hypothesis (node parameter ``class_id``)
