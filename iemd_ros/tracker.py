@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
 
+import cv2
 import numpy as np
 
 from .appearance import ImagePyramid, PatchLayout, to_gray
@@ -199,7 +200,7 @@ class IemdTracker:
         scale, emd, scale_codings, scale_warnings = self._search_scale(pyramid, best, size)
         new_center, new_size = best.center, size * scale
         best_box = _box(new_center, new_size, angle)
-        visible = _visible_fraction(new_center, new_size, frame.shape)
+        visible = _visible_fraction(new_center, new_size, angle, frame.shape)
         reason = ""
         if visible < cfg.min_visible:
             lost, reason = True, f"only {visible:.0%} of the window is inside the image"
@@ -413,12 +414,19 @@ def _particle_offsets(n: int, distance: float) -> np.ndarray:
     return distance * np.column_stack([np.cos(angles), np.sin(angles)])
 
 
-def _visible_fraction(center, size, shape) -> float:
+def _visible_fraction(center, size, angle: float, shape) -> float:
+    """Share of the window's area inside the image, the window turned by ``angle`` about its centre.
+
+    In pixel-edge coordinates the image spans [0, W] x [0, H] and the window is
+    centred at ``center + 0.5`` (pixel centres at integers, as ``centre_box``).
+    """
     h_img, w_img = shape[:2]
-    x0, y0 = centre_box(center, size)[:2]
-    ix = max(0.0, min(x0 + size[0], w_img) - max(x0, 0.0))
-    iy = max(0.0, min(y0 + size[1], h_img) - max(y0, 0.0))
-    return ix * iy / float(size[0] * size[1])
+    c, s = np.cos(angle), np.sin(angle)
+    corners = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]) * (np.asarray(size) / 2.0)
+    window = corners @ np.array([[c, s], [-s, c]]) + np.asarray(center) + 0.5
+    image = np.array([[0.0, 0.0], [w_img, 0.0], [w_img, h_img], [0.0, h_img]], dtype=np.float32)
+    area = cv2.intersectConvexConvex(window.astype(np.float32), image)[0]
+    return max(float(area), 0.0) / float(size[0] * size[1])
 
 
 def _apply_prior(H: np.ndarray, center, size):

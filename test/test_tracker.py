@@ -9,6 +9,7 @@ from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
 from iemd_ros.otb import load_sequence, read_frame
 from iemd_ros.template import TemplateDictionary
+from iemd_ros.tracker import _visible_fraction
 
 
 def texture(seed=0, shape=(240, 320), blob=5):
@@ -152,6 +153,18 @@ def test_target_leaving_the_image_is_reported_lost():
     H = np.array([[1, 0, -60.0], [0, 1, 0], [0, 0, 1]])  # the camera says it moved off the left edge
     result = tracker.update(frame, prior=H)
     assert result.lost and "inside the image" in result.reason
+
+
+def test_visible_fraction_of_a_turned_window():
+    shape = (200, 300)
+    # A 10 x 40 window whose centre is 10 px (pixel edges) from the left border:
+    # upright it is all inside, turned by 90 degrees it reaches 10 px beyond the border.
+    assert _visible_fraction((9.5, 99.5), (10.0, 40.0), 0.0, shape) == pytest.approx(1.0)
+    assert _visible_fraction((9.5, 99.5), (10.0, 40.0), np.pi / 2, shape) == pytest.approx(0.75, abs=1e-5)
+    # A square centred on the image corner keeps a quarter inside at any angle.
+    for angle in (0.0, 0.3, np.pi / 4):
+        assert _visible_fraction((-0.5, -0.5), (20.0, 20.0), angle, shape) == pytest.approx(0.25, abs=1e-5)
+    assert _visible_fraction((400.0, 100.0), (20.0, 20.0), 0.3, shape) == 0.0
 
 
 def test_reconstructed_template_removes_an_occluder():
