@@ -20,7 +20,12 @@ import numpy as np
 
 
 def to_gray(frame: np.ndarray) -> np.ndarray:
-    """Grey levels in [0, 1] (float32) of an HxW or HxWx3 (BGR) uint8 frame."""
+    """Grey levels in [0, 1] (float32) of an HxW or HxWx3 (BGR) uint8 frame.
+
+    The paper's appearance vectors are "normalized pixel values" without saying which channels.
+    Patches of all three BGR channels (a 3mn-vector each, normalized together) were measured at
+    27.7 % mean average overlap over the 12 OTB sequences against 31.9 % for grey levels.
+    """
     if frame.ndim == 3:
         frame = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
     return np.multiply(frame, np.float32(1.0 / 255.0), dtype=np.float32)

@@ -25,7 +25,10 @@ from .template import TemplateDictionary
 class TrackerConfig:
     """Parameters of the tracker; defaults follow the paper where it gives values."""
 
-    template_size: tuple[int, int] = (32, 32)  # (width, height) of the resampled window
+    # (width, height) of the resampled window.  Finer templates with the same 7x7 patch grid were
+    # measured over the 12 OTB sequences (README, "Grey levels and template size"): 48x48 31.2 %,
+    # 64x64 27.0 %, 96x96 33.2 % (14.6 ms) against 31.9 % for the paper's 32x32.
+    template_size: tuple[int, int] = (32, 32)
     patch_size: tuple[int, int] = (8, 8)  # local patch m x n
     patch_step: int = 4
     normalization: str = "patch"  # grey-level normalization of the patches: see PatchLayout.extract
