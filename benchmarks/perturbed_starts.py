@@ -21,23 +21,30 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import TrackerConfig
-from iemd_ros.evaluation import IemdAdapter, make_tracker, run_tracker
+from iemd_ros.evaluation import IemdAdapter, collect_sequences, make_tracker, run_tracker
 from iemd_ros.metrics import score_sequence
-from iemd_ros.otb import default_root, list_sequences, load_sequence
+from iemd_ros.otb import default_root, load_sequence
 
 DIAGONALS = ((0.0, 0.0), (1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0))
 
 
 def run(job):
-    """(average overlap, median update ms) of one tracker on one sequence from one start."""
-    label, config, name, direction, shift = job
+    """[(average overlap, median update ms) per start] of each run on one sequence, decoded once."""
+    name, runs, shift = job
     seq = load_sequence(name, default_root())
+    frames = list(seq.frames())
     first = np.asarray(seq.gt_boxes[0], dtype=float)
-    start = first + np.array([direction[0] * shift * first[2], direction[1] * shift * first[3], 0.0, 0.0])
-    tracker = IemdAdapter(TrackerConfig(**config)) if config is not None else make_tracker(label)
-    result = run_tracker(tracker, seq.frames(), start)
-    scores = score_sequence(result.boxes, seq.gt_boxes, name)
-    return scores.average_overlap, float(np.median(result.update_seconds) * 1e3)
+    out = []
+    for label, config in runs:
+        rows = []
+        for direction in DIAGONALS:
+            start = first + np.array([direction[0] * shift * first[2], direction[1] * shift * first[3], 0.0, 0.0])
+            tracker = IemdAdapter(config) if config is not None else make_tracker(label)
+            result = run_tracker(tracker, frames, start)
+            scores = score_sequence(result.boxes, seq.gt_boxes, name)
+            rows.append((scores.average_overlap, float(np.median(result.update_seconds) * 1e3)))
+        out.append(rows)
+    return out
 
 
 def main() -> None:
@@ -48,17 +55,20 @@ def main() -> None:
     parser.add_argument("--shift", type=float, default=0.1, help="start shift, fraction of the box size")
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
-    names = args.sequences.split(",") if args.sequences else list_sequences(default_root())
-    runs = [(f"iemd {c}" if args.config else "iemd", ast.literal_eval(c)) for c in (args.config or ["{}"])]
-    runs += [(peer, None) for peer in args.peers.split(",") if peer]
-    jobs = [(label, config, name, d, args.shift) for label, config in runs for name in names for d in DIAGONALS]
+    names = [seq.name for seq in collect_sequences([], args.sequences.split(",") if args.sequences else None)]
+    # Checked here, before any run: a bad key or peer fails at once with its own message.
+    runs = [(f"iemd {c}" if args.config else "iemd", TrackerConfig.from_dict(ast.literal_eval(c)))
+            for c in (args.config or ["{}"])]
+    peers = [peer for peer in args.peers.split(",") if peer]
+    for peer in peers:
+        make_tracker(peer)
+    runs += [(peer, None) for peer in peers]
     with Pool(args.jobs) as pool:
-        results = pool.map(run, jobs, chunksize=1)
-    per_run = len(names) * len(DIAGONALS)
+        results = pool.map(run, [(name, runs, args.shift) for name in names], chunksize=1)
     print(f"{len(names)} sequences x {len(DIAGONALS)} starts (ground truth, and shifted by {args.shift:g} of its "
           "size along the diagonals)")
     for i, (label, _) in enumerate(runs):
-        rows = results[i * per_run:(i + 1) * per_run]
+        rows = [row for per_sequence in results for row in per_sequence[i]]
         overlap = np.array([ao for ao, _ in rows]).reshape(len(names), len(DIAGONALS)) * 100
         speed = np.median([ms for _, ms in rows])
         starts = " ".join(f"{v:4.1f}" for v in overlap.mean(axis=0))
