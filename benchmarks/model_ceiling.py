@@ -29,7 +29,8 @@ from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
-from iemd_ros.otb import default_root, list_sequences, load_sequence, read_frame
+from iemd_ros.evaluation import collect_sequences
+from iemd_ros.otb import default_root, load_sequence, read_frame
 
 OFFSETS = np.linspace(-0.6, 0.6, 13)
 CAPTURE_STARTS = (0.05, 0.1, 0.2, 0.3, 0.4)
@@ -57,8 +58,7 @@ def measure(job):
     tracker = IemdTracker(TrackerConfig(update_templates=False))
     tracker.init(first, seq.gt_boxes[0])
     template_size = tracker.config.template_size
-    first_box = np.asarray(seq.gt_boxes[0], dtype=float)
-    reference = ImagePyramid(to_gray(first)).sample(box_centre(first_box), first_box[2:], template_size).ravel()
+    reference = tracker.dictionary.templates[0].ravel()  # the frame-1 window init() sampled (never updated here)
     rows = []
     for k in range(max(stride, jump), len(seq), stride):
         truth = np.asarray(seq.gt_boxes[k], dtype=float)
@@ -107,7 +107,7 @@ def main():
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--capture", action="store_true", help="also measure the descent's capture range")
     args = parser.parse_args()
-    names = args.sequences.split(",") if args.sequences else list_sequences(default_root())
+    names = [seq.name for seq in collect_sequences([], args.sequences.split(",") if args.sequences else None)]
     jobs = [(name, args.stride, args.jump) for name in names]
     with Pool(args.jobs) as pool:
         results = pool.map(measure, jobs)

@@ -37,7 +37,8 @@ from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.emd import ground_distance, solve_emd
 from iemd_ros.histogram import candidate_weights
-from iemd_ros.otb import default_root, list_sequences, load_sequence, read_frame
+from iemd_ros.evaluation import collect_sequences
+from iemd_ros.otb import default_root, load_sequence, read_frame
 from model_ceiling import grid_argmin  # benchmarks/ is the script's directory
 
 OFFSETS = np.linspace(-0.4, 0.4, 9)
@@ -93,7 +94,7 @@ def measure(job):
     rows = []
     for k in range(stride, min(frames, len(seq)), stride):
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
-        center, size = box_centre(seq.gt_boxes[k]), tracker._size
+        center, size = box_centre(seq.gt_boxes[k]), np.asarray(seq.gt_boxes[0][2:], dtype=float)  # frame-1 size
         accuracy = votes.vote_accuracy(pyramid.sample(center, size, tsize))
         patch_bins = np.hypot(*grid_argmin(lambda c: tracker._candidate(pyramid, c, size).emd()[0], center, size,
                                            OFFSETS))
@@ -111,7 +112,7 @@ def main():
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     with Pool(args.jobs) as pool:
-        names = args.sequences.split(",") if args.sequences else list_sequences(default_root())
+        names = [seq.name for seq in collect_sequences([], args.sequences.split(",") if args.sequences else None)]
         results = pool.map(measure, [(n, args.frames, args.stride) for n in names])
     print(f"{'sequence':14s} {'votes f1 %':>10s} {'votes k %':>10s} {'argmin (a)':>11s} {'argmin (b)':>11s}"
           "   (argmin: mean distance from the truth, window sizes)")
