@@ -41,10 +41,11 @@ def main():
             offsets = rng.uniform(-args.offset, args.offset, (args.starts, 2))
             tracker = IemdTracker()
             tracker.init(prev, seq.gt_boxes[k - 1])
-            for gradient in GRADIENTS:
-                tracker.config.gradient = gradient  # only the descent reads it
-                for offset in offsets:
-                    state = tracker._descend(pyramid, tracker._candidate(pyramid, truth + offset, size))
+            for offset in offsets:
+                start = tracker._candidate(pyramid, truth + offset, size)  # one start model for all three
+                for gradient in GRADIENTS:
+                    tracker.config.gradient = gradient  # only the descent reads it
+                    state = tracker._descend(pyramid, start)
                     errors[gradient].append(np.linalg.norm(state.center - truth))
                     iterations[gradient].append(state.iterations)
     print(f"starts up to {args.offset} px from the ground truth, {len(errors['paper'])} per gradient")
