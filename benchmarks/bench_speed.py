@@ -22,7 +22,7 @@ import numpy as np
 
 from iemd_ros.cli import CliParser, cli_main
 from iemd_ros.evaluation import TRACKERS, make_tracker, run_tracker
-from iemd_ros.otb import default_root, list_sequences, load_sequence, read_frame
+from iemd_ros.otb import default_root, list_sequences, load_sequence
 from iemd_ros.recordings import load_recording
 
 DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
@@ -36,8 +36,8 @@ def desk_sequence(n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
 
 def otb_sequence(name: str, root: Path, n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
     seq = load_sequence(name, root).head(n)
-    shape = "x".join(map(str, read_frame(seq.frame_paths[0]).shape[1::-1]))
-    return f"{name}-{shape}", list(seq.frames()), seq.gt_boxes[0]
+    frames = list(seq.frames())
+    return f"{name}-{'x'.join(map(str, frames[0].shape[1::-1]))}", frames, seq.gt_boxes[0]
 
 
 def main(argv=None) -> int:
