@@ -31,14 +31,14 @@ def overlap(job):
     seq = load_sequence(name, default_root())
     if frames:
         seq = seq.head(frames)
-    scores, run = evaluate_sequence(seq, IemdAdapter(TrackerConfig(**config)))
+    scores, run = evaluate_sequence(seq, IemdAdapter(config))
     return scores.average_overlap, float(np.median(run.update_seconds) * 1e3)
 
 
 def discrimination(job, radius=40, grid=4):
     name, config, _ = job
     seq = load_sequence(name, default_root())
-    tracker = IemdTracker(TrackerConfig(**config))
+    tracker = IemdTracker(config)
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     picks = np.linspace(10, len(seq) - 1, 5).astype(int)
     scores = []
@@ -61,13 +61,14 @@ def main():
     parser.add_argument("--discrimination", action="store_true")
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
-    configs = [ast.literal_eval(c) for c in (args.config or ["{}"])]
+    overrides = [ast.literal_eval(c) for c in (args.config or ["{}"])]
+    configs = [TrackerConfig.from_dict(o) for o in overrides]  # checked before any run
     names = args.sequences.split(",")
     jobs = [(n, c, args.frames) for c in configs for n in names]
     with Pool(args.jobs) as pool:
         results = pool.map(overlap, jobs)
         disc = pool.map(discrimination, jobs) if args.discrimination else None
-    for ci, config in enumerate(configs):
+    for ci, config in enumerate(overrides):
         rows = results[ci * len(names):(ci + 1) * len(names)]
         cells = " ".join(f"{n}={ao * 100:5.1f}%" for n, (ao, _) in zip(names, rows))
         speed = np.median([ms for _, ms in rows])
