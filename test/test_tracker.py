@@ -1,4 +1,6 @@
 """IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
+import dataclasses
+
 import cv2
 import numpy as np
 import pytest
@@ -153,6 +155,25 @@ def test_target_leaving_the_image_is_reported_lost():
     H = np.array([[1, 0, -60.0], [0, 1, 0], [0, 0, 1]])  # the camera says it moved off the left edge
     result = tracker.update(frame, prior=H)
     assert result.lost and "inside the image" in result.reason
+
+
+def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
+    import iemd_ros.candidate as candidate
+    solves = []
+    solve = candidate.solve_emd
+
+    def non_optimal(*args, **kwargs):  # every solve reports a non-optimal exit
+        solves.append(1)
+        return dataclasses.replace(solve(*args, **kwargs), optimal=False)
+
+    monkeypatch.setattr(candidate, "solve_emd", non_optimal)
+    frame = texture(seed=5)
+    tracker = IemdTracker(TrackerConfig(particle_trigger=0.0))  # the particles run on every frame
+    tracker.init(frame, (100.0, 80.0, 40.0, 40.0))
+    solves.clear()
+    result = tracker.update(shifted(frame, 3.0, 2.0))
+    assert result.starts == 1 + tracker.config.n_particles
+    assert result.solver_warnings == len(solves) > 0
 
 
 def test_visible_fraction_of_a_turned_window():
