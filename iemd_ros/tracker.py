@@ -111,11 +111,16 @@ class TrackResult:
 class _Descent:
     """Outcome of Algorithm 1 from one starting point."""
 
-    center: np.ndarray  # window centre, image pixels
+    model: CandidateModel  # the window it ended at
     emd: float
     iterations: int = 0
     codings: int = 0  # candidate models built for its trial steps (the caller counts the start's)
     warnings: int = 0
+
+    @property
+    def center(self) -> np.ndarray:
+        """Window centre, image pixels."""
+        return self.model.center
 
 
 class IemdTracker:
@@ -200,8 +205,8 @@ class IemdTracker:
             searches.append(candidate)
             if candidate.emd < best.emd:
                 best = candidate
-        scale, emd, scale_codings, scale_warnings = self._search_scale(pyramid, best, size)
-        new_center, new_size = best.center, size * scale
+        final, scale, emd, scale_codings, scale_warnings = self._search_scale(pyramid, best, size)
+        new_center, new_size = final.center, final.size
         best_box = _box(new_center, new_size, angle)
         visible = _visible_fraction(new_center, new_size, angle, frame.shape)
         reason = ""
@@ -215,8 +220,7 @@ class IemdTracker:
         if not lost:
             self._center, self._size, self._angle = new_center, new_size, angle
             if cfg.update_templates:
-                template = pyramid.sample(new_center, new_size, cfg.template_size, angle=angle)
-                if self.dictionary.observe(template, emd, self._frame_index):
+                if self.dictionary.observe(final.template, emd, self._frame_index):
                     self._refresh_target()
         return TrackResult(
             box=best_box, emd=emd, iterations=best.iterations, lost=lost, scale=scale, angle=angle, starts=starts,
@@ -322,8 +326,7 @@ class IemdTracker:
         c, s = np.cos(model.angle), np.sin(model.angle)
         axes = np.array([[c, -s], [s, c]])  # window axes -> image axes
         emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
-        state = _Descent(center=model.center, emd=emd,
-                         warnings=_not_optimal(sol))
+        state = _Descent(model=model, emd=emd, warnings=_not_optimal(sol))
         # The coarse stage samples one pyramid level up: its steps are twice as long.
         level_scale = 2.0 if coarse else 1.0
         step, min_step = cfg.step_px * level_scale, cfg.min_step_px * level_scale
@@ -338,7 +341,7 @@ class IemdTracker:
             state.codings += 1
             state.warnings += _not_optimal(s_try)
             if e_try < state.emd:  # the gradient is needed only where the step is accepted
-                state.center, state.emd, grad = trial.center, e_try, trial.gradient(cfg.gradient)
+                state.model, state.emd, grad = trial, e_try, trial.gradient(cfg.gradient)
             else:
                 step *= 0.5
         return state
@@ -353,23 +356,25 @@ class IemdTracker:
         measured as runaway growth on Car4.)  In each direction the search keeps
         stepping by ``scale_step`` while the EMD decreases, up to ``scale_range``
         (the paper's gyro experiment searches +-10 %: a camera closing in on the
-        target grows it faster than 2 % per frame).  Returns (scale, emd, models built, solver warnings).
+        target grows it faster than 2 % per frame).  Returns (the chosen window's model, scale, emd,
+        models built, solver warnings).
         """
         cfg = self.config
-        best_scale, best_emd, codings, warnings = 1.0, state.emd, 0, 0
+        best, best_scale, best_emd, codings, warnings = state.model, 1.0, state.emd, 0, 0
         if cfg.scale_step == 0:
-            return best_scale, best_emd, codings, warnings
+            return best, best_scale, best_emd, codings, warnings
         n_steps = int(np.floor(cfg.scale_range / cfg.scale_step + 1e-9))
         for direction in (-1.0, 1.0):
             for n in range(1, n_steps + 1):
                 scale = 1.0 + direction * n * cfg.scale_step
-                emd, sol = self._candidate(pyramid, state.center, size * scale).emd()
+                model = self._candidate(pyramid, state.center, size * scale)
+                emd, sol = model.emd()
                 codings += 1
                 warnings += _not_optimal(sol)
                 if emd >= best_emd:
                     break
-                best_scale, best_emd = scale, emd
-        return best_scale, best_emd, codings, warnings
+                best, best_scale, best_emd = model, scale, emd
+        return best, best_scale, best_emd, codings, warnings
 
 
 def compile_jit() -> None:
