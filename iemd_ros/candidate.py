@@ -23,7 +23,7 @@ import numpy as np
 from .appearance import ImagePyramid, PatchLayout
 from .emd import EmdSolution, appearance_distance, emd_gradient, envelope_gradient, solve_emd
 from .histogram import candidate_weights, target_weights
-from .sparse_coding import SparseCoder, max_alignment_pooling
+from .template import TemplateDictionary
 
 
 @dataclass(frozen=True)
@@ -58,9 +58,10 @@ class CandidateModel:
     """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``, against ``target``."""
 
     def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, target: TargetModel,
-                 coder: SparseCoder | None, n_templates: int, alpha: float, bandwidth: float, coarse: int = 0,
+                 dictionary: TemplateDictionary | None, alpha: float, bandwidth: float, coarse: int = 0,
                  angle: float = 0.0):
-        """``coder=None`` (the coarse stage) gives every patch code weight 1: only the kernel weights bins.
+        """``dictionary`` codes the patches (:meth:`TemplateDictionary.code_weights`); None (the
+        coarse stage) gives every patch code weight 1: only the kernel weights bins.
 
         ``angle``: the window's orientation in the image (see ImagePyramid.sample);
         positions and gradients are in the window's own axes.
@@ -76,10 +77,7 @@ class CandidateModel:
         self.template = pyramid.sample(self.center, self.size, layout.template_size, coarse, angle)
         self.eps = layout.extract(self.template)
         self.pos = layout.positions()
-        if coder is None:
-            self.code_weights = np.ones(len(self.eps))
-        else:
-            self.code_weights = max_alignment_pooling(coder.encode(self.eps.T), n_templates)
+        self.code_weights = np.ones(len(self.eps)) if dictionary is None else dictionary.code_weights(self.eps)
         self.appearance_cost = alpha * appearance_distance(target.eps, self.eps, target.eps_sq_norms)
         self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import PatchLayout
-from .sparse_coding import SparseCoder
+from .sparse_coding import SparseCoder, max_alignment_pooling
 
 
 class TemplateDictionary:
@@ -37,6 +37,11 @@ class TemplateDictionary:
         self.templates.append(np.asarray(template, dtype=np.float64))
         self.latest_weight, self.latest_index = float(np.exp(-emd)), index
         self._rebuild()
+
+    def code_weights(self, eps: np.ndarray) -> np.ndarray:
+        """Pooled bin weights ||a-bar||_inf of patches ``eps`` (N, d): their sparse codes over Phi
+        (eq. lagrange) with max-alignment pooling over the L templates (section 4)."""
+        return max_alignment_pooling(self.coder.encode(eps.T), len(self.templates))
 
     @property
     def full(self) -> bool:

@@ -17,7 +17,6 @@ import numpy as np
 from .appearance import ImagePyramid, PatchLayout, to_gray
 from .boxes import box_centre, centre_box, check_box
 from .candidate import CandidateModel, TargetModel
-from .sparse_coding import max_alignment_pooling
 from .template import TemplateDictionary
 
 
@@ -253,8 +252,7 @@ class IemdTracker:
         at a rate of 0.01, 0.03 or 0.1 per frame gave 27.6, 28.0 and 22.9 % against
         31.9 % over the 12 OTB sequences.
         """
-        codes = self.dictionary.coder.encode(self._target_eps.T)
-        pooled = max_alignment_pooling(codes, len(self.dictionary.templates))
+        pooled = self.dictionary.code_weights(self._target_eps)
         self._target = TargetModel.from_patches(self.layout.positions(), self._target_eps, pooled,
                                                 self.config.kernel_bandwidth)
 
@@ -262,11 +260,10 @@ class IemdTracker:
         """The candidate model at a window, against the full target (or the coarse stage's)."""
         cfg = self.config
         if coarse:
-            return CandidateModel(pyramid, self.layout, center, size, self._coarse_target, None, 1, cfg.alpha,
+            return CandidateModel(pyramid, self.layout, center, size, self._coarse_target, None, cfg.alpha,
                                   cfg.kernel_bandwidth, coarse=1, angle=self._search_angle)
-        return CandidateModel(pyramid, self.layout, center, size, self._target, self.dictionary.coder,
-                              len(self.dictionary.templates), cfg.alpha, cfg.kernel_bandwidth,
-                              angle=self._search_angle)
+        return CandidateModel(pyramid, self.layout, center, size, self._target, self.dictionary, cfg.alpha,
+                              cfg.kernel_bandwidth, angle=self._search_angle)
 
     def _search(self, pyramid: ImagePyramid, center, size) -> _Descent:
         """Coarse-to-fine Algorithm 1 from one starting point.

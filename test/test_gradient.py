@@ -31,8 +31,8 @@ def model_setup():
     tracker.init(frame0, box)
     center = box_centre(box)
     model = CandidateModel(ImagePyramid(to_gray(frame1)), tracker.layout, center, np.array(box[2:], float),
-                           tracker._target, tracker.dictionary.coder, len(tracker.dictionary.templates),
-                           tracker.config.alpha, tracker.config.kernel_bandwidth)
+                           tracker._target, tracker.dictionary, tracker.config.alpha,
+                           tracker.config.kernel_bandwidth)
     return tracker, model
 
 
