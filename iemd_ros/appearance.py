@@ -31,6 +31,12 @@ def to_gray(frame: np.ndarray) -> np.ndarray:
     return np.multiply(frame, np.float32(1.0 / 255.0), dtype=np.float32)
 
 
+def window_axes(angle: float) -> np.ndarray:
+    """Rotation taking the axes of a window turned by ``angle`` to image axes (columns: its x and y axes)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
 class ImagePyramid:
     """Gaussian pyramid of one frame, so large windows are sampled without aliasing.
 
@@ -69,8 +75,7 @@ class ImagePyramid:
         f = 2.0**level
         # Image point of template pixel u: c + R(angle) ((u - (T-1)/2) * s); at level l
         # a full-resolution coordinate x sits at (x + 0.5) / 2^l - 0.5.
-        c, si = np.cos(angle), np.sin(angle)
-        linear = np.array([[c * sx, -si * sy], [si * sx, c * sy]]) / f
+        linear = window_axes(angle) * [sx, sy] / f
         origin = (np.asarray(center, dtype=np.float64) + 0.5) / f - 0.5 - linear @ [(tw - 1) / 2, (th - 1) / 2]
         warp = np.column_stack([linear, origin])
         return cv2.warpAffine(

@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass, fields
 import cv2
 import numpy as np
 
-from .appearance import ImagePyramid, PatchLayout, to_gray
+from .appearance import ImagePyramid, PatchLayout, to_gray, window_axes
 from .boxes import box_centre, centre_box, check_box
 from .candidate import CandidateModel, TargetModel
 from .template import TemplateDictionary
@@ -320,8 +320,7 @@ class IemdTracker:
         cfg = self.config
         size, coarse = model.size, bool(model.coarse)
         half = size / 2.0
-        c, s = np.cos(model.angle), np.sin(model.angle)
-        axes = np.array([[c, -s], [s, c]])  # window axes -> image axes
+        axes = window_axes(model.angle)
         emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
         state = _Descent(model=model, emd=emd, warnings=_not_optimal(sol))
         # The coarse stage samples one pyramid level up: its steps are twice as long.
@@ -418,9 +417,8 @@ def _visible_fraction(center, size, angle: float, shape) -> float:
     centred at ``center + 0.5`` (pixel centres at integers, as ``centre_box``).
     """
     h_img, w_img = shape[:2]
-    c, s = np.cos(angle), np.sin(angle)
     corners = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]) * (np.asarray(size) / 2.0)
-    window = corners @ np.array([[c, s], [-s, c]]) + np.asarray(center) + 0.5
+    window = corners @ window_axes(angle).T + np.asarray(center) + 0.5
     image = np.array([[0.0, 0.0], [w_img, 0.0], [w_img, h_img], [0.0, h_img]], dtype=np.float32)
     area = cv2.intersectConvexConvex(window.astype(np.float32), image)[0]
     return max(float(area), 0.0) / float(size[0] * size[1])
