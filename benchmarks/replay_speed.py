@@ -25,7 +25,7 @@ from pathlib import Path
 
 from iemd_ros.bag_io import deserialize, iter_messages, open_bag, select_topics
 from iemd_ros.bag_make import source_from_folder, write_bag
-from iemd_ros.conversions import image_to_array
+from iemd_ros.conversions import image_from_msg
 from iemd_ros.replay import replay
 
 DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
@@ -42,7 +42,7 @@ def io_only(bag: Path) -> tuple[float, int]:
         for conn, _, raw in iter_messages(reader, conns, bag):
             msg = deserialize(reader, raw, conn.msgtype, bag)
             if conn.topic == topics.image:
-                image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, bool(msg.is_bigendian))
+                image_from_msg(msg)
                 n += 1
         return time.perf_counter() - t0, n
     finally:

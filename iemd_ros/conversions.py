@@ -21,7 +21,7 @@ from .camera import CameraModel
 from .boxes import box_centre, centre_box, check_box
 
 __all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "camera_model_from_info", "camera_model_from_msg",
-           "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
+           "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
            "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
 
 # encoding -> (channels, bytes per channel)
@@ -138,6 +138,18 @@ def camera_model_from_info(k, d, distortion_model: str, width: int, height: int)
 def stamp_to_ns(sec: int, nanosec: int) -> int:
     """``builtin_interfaces/Time`` -> integer nanoseconds."""
     return int(sec) * 1_000_000_000 + int(nanosec)
+
+
+def image_from_msg(msg) -> np.ndarray:
+    """A ``sensor_msgs/Image`` (rclpy or rosbags message) -> tracker frame, by :func:`image_to_array`."""
+    return image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, bool(msg.is_bigendian))
+
+
+def imu_sample(msg) -> tuple[int, tuple[float, float, float], float]:
+    """A ``sensor_msgs/Imu`` (rclpy or rosbags message) -> (stamp ns, gyro rates (x, y, z) rad/s,
+    ``angular_velocity_covariance[0]``): the arguments of ``TrackingPipeline.add_imu_message``."""
+    w = msg.angular_velocity
+    return stamp_ns(msg.header), (w.x, w.y, w.z), msg.angular_velocity_covariance[0]
 
 
 def stamp_ns(header) -> int:

@@ -43,7 +43,7 @@ from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithP
 from .boxes import check_box
 from .cli import one_line
 from .conversions import (CLASS_ID, DETECTION_ID, array_to_image_fields, bbox_to_box, camera_model_from_msg,
-                          detection_values, image_to_array, stamp_ns)
+                          detection_values, image_from_msg, imu_sample, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
 from .pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
@@ -269,9 +269,7 @@ class TrackerNode(Node):
 
     def _on_imu(self, msg: Imu) -> None:
         self._last_imu_wall = time.monotonic()
-        t = stamp_ns(msg.header)
-        w = msg.angular_velocity
-        if not self.pipeline.add_imu_message(t, (w.x, w.y, w.z), msg.angular_velocity_covariance[0]):
+        if not self.pipeline.add_imu_message(*imu_sample(msg)):
             self._warn(self.pipeline.last_reasons()["imu_reason"])
         # Wake the worker only when this sample lets the frame it holds go.  No race: the sample is
         # stored before the lock is taken here, and the worker sets _awaiting_imu and checks gyro_ready
@@ -365,7 +363,7 @@ class TrackerNode(Node):
             return
         m = frames[i]
         try:
-            frame = image_to_array(m.encoding, m.height, m.width, m.step, m.data, m.is_bigendian)
+            frame = image_from_msg(m)
             self.pipeline.init(frame, box, int(stamps[i]))
         except ValueError as exc:
             self._note = f"~/init failed: {exc}"
@@ -377,7 +375,7 @@ class TrackerNode(Node):
     def _handle_frame(self, msg: Image, received) -> None:
         stamp = stamp_ns(msg.header)
         try:
-            frame = image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, msg.is_bigendian)
+            frame = image_from_msg(msg)
         except ValueError as exc:
             self.pipeline.note_bad_image(str(exc), stamp)
             self._warn(f"image rejected: {exc}")

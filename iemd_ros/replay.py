@@ -53,7 +53,8 @@ from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Pro
 from .boxes import check_box
 from .camera import CameraModel
 from .cli import CliParser, cli_main
-from .conversions import CLASS_ID, DETECTION_ID, camera_model_from_msg, detection_values, image_to_array, stamp_ns
+from .conversions import (CLASS_ID, DETECTION_ID, camera_model_from_msg, detection_values, image_from_msg,
+                          imu_sample, stamp_ns)
 from .drawing import draw_result
 from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
 
@@ -342,15 +343,13 @@ def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | No
             if conn.topic == topics.image:
                 stamp = stamp_ns(msg.header)
                 try:
-                    img = image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data,
-                                         bool(msg.is_bigendian))
+                    img = image_from_msg(msg)
                     pending.append(_Frame(log_t, stamp, msg.header.frame_id, img))
                 except ValueError as exc:
                     pending.append(_Frame(log_t, stamp, msg.header.frame_id, None, str(exc)))
             elif conn.topic == topics.imu:
                 imu_seen += 1
-                av = msg.angular_velocity
-                pipe.add_imu_message(stamp_ns(msg.header), (av.x, av.y, av.z), msg.angular_velocity_covariance[0])
+                pipe.add_imu_message(*imu_sample(msg))
             else:
                 try:
                     pipe.set_camera(camera_model_from_msg(msg))

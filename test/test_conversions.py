@@ -1,12 +1,14 @@
 """Message-field <-> numpy conversions (no ROS needed)."""
 import array
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from iemd_ros.boxes import box_centre, centre_box, check_box
 from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info,
-                                  detection_values, image_to_array, ns_to_stamp, stamp_to_ns)
+                                  detection_values, image_from_msg, image_to_array, imu_sample, ns_to_stamp,
+                                  stamp_to_ns)
 from iemd_ros.pipeline import FrameResult
 
 
@@ -135,3 +137,13 @@ def test_check_box_names_what_is_wrong(box, message):
         check_box(box, "marker")
     assert str(exc.value) == message
     np.testing.assert_array_equal(check_box([1, 2, 3, 4]), [1.0, 2.0, 3.0, 4.0])
+
+
+def test_image_and_imu_messages():
+    header = SimpleNamespace(stamp=SimpleNamespace(sec=3, nanosec=250))
+    pix = np.arange(12, dtype=np.uint8).reshape(3, 4)
+    image = SimpleNamespace(header=header, **array_to_image_fields(pix))
+    np.testing.assert_array_equal(image_from_msg(image), pix)
+    imu = SimpleNamespace(header=header, angular_velocity=SimpleNamespace(x=0.1, y=-0.2, z=0.3),
+                          angular_velocity_covariance=[0.5] + [0.0] * 8)
+    assert imu_sample(imu) == (3_000_000_250, (0.1, -0.2, 0.3), 0.5)
