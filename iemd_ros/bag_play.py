@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .bag_io import BagError, Progress, iter_messages, open_bag, ros2_typestore
-from .cli import CliParser, cli_main
+from .cli import CliParser, cli_main, split_ros_args
 from .conversions import ns_to_stamp
 
 
@@ -187,9 +187,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     def body() -> int:
-        args = list(sys.argv[1:] if argv is None else argv)
-        ros_args = args[args.index("--ros-args"):] if "--ros-args" in args else []
-        a = build_parser().parse_args(args[:len(args) - len(ros_args)])
+        args, ros_args = split_ros_args(argv)
+        a = build_parser().parse_args(args)
         stats = play(a.bag, a.rate, a.topics, _parse_remaps(a.remap), a.delay, a.wait_subscribers, a.clock,
                      a.qos_depth, progress=a.progress, ros_args=ros_args)
         n = sum(stats.published.values())

@@ -52,7 +52,7 @@ from .bag_io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Pro
                      iter_messages, open_bag, select_topics)
 from .boxes import check_box
 from .camera import CameraModel
-from .cli import CliParser, cli_main
+from .cli import CliParser, cli_main, split_ros_args
 from .conversions import (CLASS_ID, DETECTION_ID, camera_model_from_msg, detection_values, image_from_msg,
                           imu_sample, stamp_ns)
 from .drawing import draw_result
@@ -458,9 +458,7 @@ def load_config(path) -> PipelineConfig:
 
 def main(argv: list[str] | None = None) -> int:
     def body() -> int:
-        args = list(sys.argv[1:] if argv is None else argv)
-        if "--ros-args" in args:            # from `ros2 run` / launch: the replay has no ROS arguments
-            args = args[:args.index("--ros-args")]
+        args, _ = split_ros_args(argv)      # from `ros2 run` / launch: the replay has no ROS arguments
         a = build_parser().parse_args(args)
         box = parse_box(a.init)
         cfg = load_config(a.config) if a.config else PipelineConfig()

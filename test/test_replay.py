@@ -14,6 +14,7 @@ from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
 
 from iemd_ros.bag_io import BagWriter, header
 from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag, write_gt
+from iemd_ros.cli import split_ros_args
 from iemd_ros.conversions import bbox_to_box
 from iemd_ros.metrics import iou, score_sequence
 from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
@@ -295,3 +296,9 @@ def test_parse_box_takes_a_string_or_a_sequence():
         parse_box((1, 2, 0, 4))
     with pytest.raises(ValueError, match="--init has non-finite values"):
         parse_box([1, 2, float("nan"), 4])
+
+
+def test_ros_args_are_split_off():
+    assert split_ros_args(["a.bag", "--init", "1,2,3,4", "--ros-args", "-r", "x:=y"]) == (
+        ["a.bag", "--init", "1,2,3,4"], ["--ros-args", "-r", "x:=y"])
+    assert split_ros_args(["a.bag"]) == (["a.bag"], [])
