@@ -17,7 +17,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.gyro import GyroConfig, GyroPredictor, rotation_homography, warp_difference
+from iemd_ros.gyro import rotation_homography, warp_difference
 from iemd_ros.recordings import load_recording
 from iemd_ros.rotation import rotation_angle
 
@@ -28,9 +28,7 @@ SEQUENCES = {"desk": "cmu_hwangbo_desk", "aerial": "cmu_hwangbo_aerial",
 
 def pair_rotations(rec, offset_ns: int) -> tuple[np.ndarray, np.ndarray]:
     """Rotation (camera k+1 in camera k) of every consecutive frame pair, and a validity mask."""
-    pred = GyroPredictor(rec.camera, GyroConfig(time_offset_ns=offset_ns, buffer_ns=10 ** 13,
-                                                buffer_samples=10 ** 7))
-    pred.add_imu(rec.imu_t_ns, rec.gyro)
+    pred = rec.gyro_predictor(offset_ns)
     st = rec.frame_stamps_ns
     res = [pred.rotation(a, b) for a, b in zip(st[:-1], st[1:])]
     return np.array([r.R for r in res]), np.array([r.ok for r in res])

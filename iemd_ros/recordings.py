@@ -58,6 +58,14 @@ class Recording:
         """IMU-clock time of each frame."""
         return self.frame_stamps_ns + self.time_offset_ns
 
+    def gyro_predictor(self, time_offset_ns: int | None = None) -> GyroPredictor:
+        """A :class:`GyroPredictor` holding the whole gyro record, with the recording's camera and
+        time offset (or ``time_offset_ns``)."""
+        offset = self.time_offset_ns if time_offset_ns is None else time_offset_ns
+        pred = GyroPredictor(self.camera, GyroConfig(time_offset_ns=offset, buffer_ns=10 ** 13, buffer_samples=10 ** 7))
+        pred.add_imu(self.imu_t_ns, self.gyro)
+        return pred
+
     def load_frame(self, i: int, grey: bool = False) -> np.ndarray:
         """Frame ``i`` (0-based) as BGR uint8 (or grey)."""
         path = self.frame_files[i]
@@ -168,11 +176,7 @@ def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True
     """
     tracker = IemdTracker(config)
     tracker.init(rec.load_frame(start), rec.gt_boxes[start])
-    pred = None
-    if use_gyro:
-        pred = GyroPredictor(rec.camera, GyroConfig(time_offset_ns=rec.time_offset_ns, buffer_ns=10 ** 13,
-                                                    buffer_samples=10 ** 7))
-        pred.add_imu(rec.imu_t_ns, rec.gyro)
+    pred = rec.gyro_predictor() if use_gyro else None
     anchor, anchor_box = start, np.asarray(rec.gt_boxes[start], float)   # frame + box of the tracker's window
     results, no_prior = [], []
     for k in range(start + 1, stop):
