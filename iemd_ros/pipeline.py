@@ -283,8 +283,6 @@ class TrackingPipeline:
             self.counters["camera_infos"] += 1
             self._last["camera_error"] = ""
             cur = self._predictor.camera
-            if camera is cur:        # camera_model_from_msg is cached: a repeated CameraInfo gives the same object
-                return False
             if cur is not None and np.array_equal(cur.K, camera.K) and np.array_equal(cur.D, camera.D) \
                     and (cur.width, cur.height) == (camera.width, camera.height):
                 return False
