@@ -25,7 +25,8 @@ import numpy as np
 from .camera import CameraModel
 from .gyro import GyroConfig, GyroPredictor
 from .otb import parse_groundtruth
-from .tracker import IemdTracker, TrackerConfig, TrackResult
+from .pipeline import FrameResult, PipelineConfig, TrackingPipeline
+from .tracker import TrackerConfig
 
 __all__ = ["Recording", "load_recording", "load_cmu", "load_phone", "track_recording",
            "CMU_TIME_OFFSET_NS"]
@@ -58,11 +59,16 @@ class Recording:
         """IMU-clock time of each frame."""
         return self.frame_stamps_ns + self.time_offset_ns
 
+    def gyro_config(self, time_offset_ns: int | None = None) -> GyroConfig:
+        """Gyro settings for this recording: its time offset (or ``time_offset_ns``) and a buffer
+        that holds the whole gyro record."""
+        offset = self.time_offset_ns if time_offset_ns is None else time_offset_ns
+        return GyroConfig(time_offset_ns=offset, buffer_ns=10 ** 13, buffer_samples=10 ** 7)
+
     def gyro_predictor(self, time_offset_ns: int | None = None) -> GyroPredictor:
         """A :class:`GyroPredictor` holding the whole gyro record, with the recording's camera and
-        time offset (or ``time_offset_ns``)."""
-        offset = self.time_offset_ns if time_offset_ns is None else time_offset_ns
-        pred = GyroPredictor(self.camera, GyroConfig(time_offset_ns=offset, buffer_ns=10 ** 13, buffer_samples=10 ** 7))
+        :meth:`gyro_config`."""
+        pred = GyroPredictor(self.camera, self.gyro_config(time_offset_ns))
         pred.add_imu(self.imu_t_ns, self.gyro)
         return pred
 
@@ -166,28 +172,25 @@ def load_recording(path) -> Recording:
 
 
 def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True,
-                    config: TrackerConfig | None = None) -> tuple[list[TrackResult], list[str]]:
+                    config: TrackerConfig | None = None) -> tuple[list[FrameResult], list[str]]:
     """Track frames ``start+1 .. stop-1`` of ``rec`` from its GT box at ``start``, causally.
 
-    With ``use_gyro`` the prior for frame k is the lens-aware local homography at the tracker's
-    window, integrated from the frame that window belongs to (after a frame reported lost the
-    tracker keeps its previous window, so the rotation is integrated from that frame), as the node
-    does.  Returns the results and one note per frame that got no gyro prior.
+    The frames and the whole gyro record go through a :class:`~iemd_ros.pipeline.TrackingPipeline`,
+    so the priors are the node's: with ``use_gyro`` the prior for frame k is the lens-aware local
+    homography at the tracker's window, integrated from the frame that window belongs to (after a
+    frame reported lost the tracker keeps its previous window), and a prior the tracker refuses is
+    dropped for that frame.  Returns the results and one note per frame tracked without a gyro prior.
     """
-    tracker = IemdTracker(config)
-    tracker.init(rec.load_frame(start), rec.gt_boxes[start])
-    pred = rec.gyro_predictor() if use_gyro else None
-    anchor, anchor_box = start, np.asarray(rec.gt_boxes[start], float)   # frame + box of the tracker's window
+    cfg = PipelineConfig(tracker=config if config is not None else TrackerConfig(), gyro=rec.gyro_config(),
+                         use_gyro=use_gyro)
+    pipe = TrackingPipeline(cfg, camera=rec.camera)
+    for t, w in zip(rec.imu_t_ns, rec.gyro):
+        pipe.add_imu(int(t), w)
+    pipe.init(rec.load_frame(start), rec.gt_boxes[start], int(rec.frame_stamps_ns[start]))
     results, no_prior = [], []
     for k in range(start + 1, stop):
-        prior = None
-        if pred is not None:
-            p = pred.predict(rec.frame_stamps_ns[anchor], rec.frame_stamps_ns[k], anchor_box)
-            prior = p.prior
-            if prior is None:
-                no_prior.append(f"frame {k}: {p.reason}")
-        res = tracker.update(rec.load_frame(k), prior=prior)
+        res = pipe.process(rec.load_frame(k), int(rec.frame_stamps_ns[k]))
         results.append(res)
-        if not res.lost:
-            anchor, anchor_box = k, np.asarray(res.box, float)
+        if use_gyro and not res.gyro_used:
+            no_prior.append(f"frame {k}: {res.gyro_reason}")
     return results, no_prior
