@@ -168,15 +168,11 @@ class FrameResult:
     starts: int = 0
     processing_ms: float = 0.0
     angle: float = 0.0
+    is_init: bool = False   # the result of the frame TrackingPipeline.init started on
 
     @property
     def tracking(self) -> bool:
         return self.state == "tracking" and not self.rejected
-
-    @property
-    def is_init(self) -> bool:
-        """The result of the frame :meth:`TrackingPipeline.init` started on (``reason`` :data:`INIT_REASON`)."""
-        return self.reason == INIT_REASON
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -391,7 +387,7 @@ class TrackingPipeline:
     def init(self, frame: np.ndarray, box, stamp_ns: int) -> FrameResult:
         """(Re)start tracking the target ``box`` = (x, y, w, h) in ``frame`` stamped ``stamp_ns``.
 
-        Returns the frame's result: ``box``, score 1, ``reason`` :data:`INIT_REASON`.  Raises
+        Returns the frame's result: ``box``, score 1, ``is_init``, ``reason`` :data:`INIT_REASON`.  Raises
         ValueError for a bad frame or box (the previous target, if any, is kept then).
         """
         with self._track_lock:
@@ -406,7 +402,7 @@ class TrackingPipeline:
                 self._last["frame_reason"] = ""
                 if self._last_stamp is None or int(stamp_ns) > self._last_stamp:
                     self._last_stamp = int(stamp_ns)
-        return FrameResult(int(stamp_ns), "tracking", box, score=1.0, reason=INIT_REASON)
+        return FrameResult(int(stamp_ns), "tracking", box, score=1.0, reason=INIT_REASON, is_init=True)
 
     def reset(self) -> None:
         """Forget the target (state "uninitialized"); IMU and camera are kept."""

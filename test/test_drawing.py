@@ -2,7 +2,7 @@
 import numpy as np
 
 from iemd_ros.drawing import GYRO, INIT, LOST, TRACKING, draw_result
-from iemd_ros.pipeline import INIT_REASON, FrameResult
+from iemd_ros.pipeline import FrameResult
 
 
 def _pixels(img, colour):
@@ -11,7 +11,7 @@ def _pixels(img, colour):
 
 def test_boxes_are_drawn_in_the_state_colours_on_a_copy():
     grey = np.full((120, 160), 128, np.uint8)
-    init = draw_result(grey, FrameResult(1, "tracking", (20.0, 30.0, 40.0, 30.0), score=1.0, reason=INIT_REASON))
+    init = draw_result(grey, FrameResult(1, "tracking", (20.0, 30.0, 40.0, 30.0), score=1.0, is_init=True))
     assert init.shape == (120, 160, 3) and _pixels(init, INIT) > 100 and _pixels(init, TRACKING) == 0
     tracked = FrameResult(2, "tracking", (20.0, 30.0, 40.0, 30.0), emd=0.1, gyro_used=True,
                           gyro_box=(60.0, 50.0, 40.0, 30.0))
