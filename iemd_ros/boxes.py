@@ -23,9 +23,10 @@ def centre_box(centre, size) -> np.ndarray:
 
 
 def check_box(box, what: str = "box") -> tuple[float, float, float, float]:
-    """``box`` as 4 floats ``(x, y, w, h)``, finite with ``w, h > 0``; else ValueError naming ``what``."""
+    """``box`` (4 numbers, or the text ``"x,y,w,h"``) as 4 floats ``(x, y, w, h)``, finite with
+    ``w, h > 0``; else ValueError naming ``what`` and quoting ``box`` as given."""
     try:
-        b = np.asarray(box, dtype=float).ravel()
+        b = np.asarray(box.split(",") if isinstance(box, str) else box, dtype=float).ravel()
     except (TypeError, ValueError):
         b = np.empty(0)
     if b.shape != (4,):
