@@ -5,6 +5,7 @@ mode puts this folder, which holds conftest.py and no __init__.py, on ``sys.path
 """
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
 # The CMU desk camera (cmu_hwangbo_desk/derived_camera_info.yaml): 640x480, a small skew, plumb_bob.
@@ -15,3 +16,16 @@ DESK_K.setflags(write=False)        # CameraModel keeps the array it is given: n
 DESK_INFO = dict(image_width=640, image_height=480,
                  camera_matrix=dict(rows=3, cols=3, data=DESK_K_DATA),
                  distortion_model="plumb_bob", distortion_coefficients=dict(rows=1, cols=5, data=DESK_D))
+
+
+def texture(seed=0, shape=(240, 320), blob=5):
+    """A smooth random grey texture: uniform noise on a grid ``blob`` times coarser, resized (cubic)."""
+    rng = np.random.default_rng(seed)
+    noise = rng.uniform(0, 255, (shape[0] // blob, shape[1] // blob)).astype(np.float32)
+    return np.clip(cv2.resize(noise, (shape[1], shape[0]), interpolation=cv2.INTER_CUBIC), 0, 255).astype(np.uint8)
+
+
+def shifted(img, dx, dy, interpolation=cv2.INTER_CUBIC):
+    """``img`` translated by (dx, dy) px, borders reflected."""
+    m = np.float32([[1, 0, dx], [0, 1, dy]])
+    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=interpolation, borderMode=cv2.BORDER_REFLECT)
