@@ -8,6 +8,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from iemd_ros.conversions import bbox_to_box
+
 # The CMU desk camera (cmu_hwangbo_desk/derived_camera_info.yaml): 640x480, a small skew, plumb_bob.
 DESK_K_DATA = (570.246, -0.100721, 309.408, 0, 569.324, 217.996, 0, 0, 1)
 DESK_D = (-0.346217, 0.128289, 0, 0, 0)
@@ -29,3 +31,14 @@ def shifted(img, dx, dy, interpolation=cv2.INTER_CUBIC):
     """``img`` translated by (dx, dy) px, borders reflected."""
     m = np.float32([[1, 0, dx], [0, 1, dy]])
     return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=interpolation, borderMode=cv2.BORDER_REFLECT)
+
+
+def bbox_values(bbox) -> tuple[float, float, float, float]:
+    """A ``vision_msgs/BoundingBox2D`` (rclpy or rosbags message) -> ``(center x, center y, size_x, size_y)``."""
+    c = bbox.center.position
+    return c.x, c.y, bbox.size_x, bbox.size_y
+
+
+def detection_box(detection) -> tuple[float, float, float, float]:
+    """The tracker box ``(x, y, w, h)`` of a ``vision_msgs/Detection2D`` (by ``conversions.bbox_to_box``)."""
+    return bbox_to_box(*bbox_values(detection.bbox))

@@ -15,6 +15,7 @@ import time
 import numpy as np
 import pytest
 from bag_fixtures import make_bag, shaky_sequence
+from helpers import detection_box
 
 rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
@@ -27,7 +28,7 @@ from vision_msgs.msg import Detection2DArray  # noqa: E402
 
 from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag  # noqa: E402
 from iemd_ros.bag_play import main, play  # noqa: E402
-from iemd_ros.conversions import bbox_to_box, stamp_ns  # noqa: E402
+from iemd_ros.conversions import stamp_ns  # noqa: E402
 from iemd_ros.pipeline import PipelineConfig  # noqa: E402
 from iemd_ros.replay import replay  # noqa: E402
 
@@ -131,8 +132,7 @@ def _compare(live: dict, offline, counters) -> tuple[int, int]:
         m = live[r.stamp_ns]
         if k == 0 or r.tracking:
             assert len(m.detections) == 1, f"frame {k}: offline {r.state}, live published nothing"
-            b = m.detections[0].bbox
-            box = bbox_to_box(b.center.position.x, b.center.position.y, b.size_x, b.size_y)
+            box = detection_box(m.detections[0])
             np.testing.assert_allclose(box, r.box, rtol=0, atol=BOX_TOL_PX, err_msg=f"frame {k}")
             assert m.detections[0].results[0].hypothesis.score == pytest.approx(r.score, rel=1e-9, abs=1e-12)
         else:

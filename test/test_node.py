@@ -11,11 +11,12 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
+from helpers import bbox_values  # noqa: E402
 from ros_harness import FRAME_ID, Driver, imu_msg, level, spinning, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
 
-from iemd_ros.conversions import image_to_array, stamp_ns  # noqa: E402
+from iemd_ros.conversions import image_from_msg, stamp_ns  # noqa: E402
 from iemd_ros.boxes import box_centre  # noqa: E402
 from iemd_ros.node import TrackerNode  # noqa: E402
 from iemd_ros.synthetic import generate  # noqa: E402
@@ -53,8 +54,7 @@ def _imu_until(driver, seq, t_cam_ns, sent):
 
 
 def _boxes(arr):
-    return [(d.bbox.center.position.x, d.bbox.center.position.y, d.bbox.size_x, d.bbox.size_y, d)
-            for d in arr.detections]
+    return [(*bbox_values(d.bbox), d) for d in arr.detections]
 
 
 def test_detections_follow_the_synthetic_target_at_30hz(ctx, seq):
@@ -154,7 +154,7 @@ def test_reset_init_topic_and_initial_box_parameter(ctx, seq):
         assert drv.wait_for(lambda: any(stamp_ns(m.header) == s[4] for m in debug), 10)
         img = next(m for m in debug if stamp_ns(m.header) == s[4])
         assert (img.encoding, img.width, img.height, img.header.frame_id) == ("bgr8", 320, 240, FRAME_ID)
-        pix = image_to_array(img.encoding, img.height, img.width, img.step, img.data)
+        pix = image_from_msg(img)
         assert np.all(pix == (0, 200, 0), axis=2).sum() > 100              # the box outline
         assert np.any(pix != seq.frames[4])
         # a stamp matching no buffered frame is refused with an explanation

@@ -11,11 +11,11 @@ import cv2
 import numpy as np
 import pytest
 from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
+from helpers import detection_box
 
 from iemd_ros.bag_io import BagWriter, header
 from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag, write_gt
 from iemd_ros.cli import split_ros_args
-from iemd_ros.conversions import bbox_to_box
 from iemd_ros.metrics import iou, score_sequence
 from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
 
@@ -74,9 +74,7 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     assert [t for topic, _, t, _ in out if topic == DETECTIONS_TOPIC] == img_log
     for k, (d, r) in enumerate(zip(dets, rows[1:])):
         if r[6] in ("tracking", "init"):
-            c = d.detections[0].bbox
-            np.testing.assert_allclose(bbox_to_box(c.center.position.x, c.center.position.y, c.size_x, c.size_y),
-                                       [float(v) for v in r[1:5]], atol=1e-9)
+            np.testing.assert_allclose(detection_box(d.detections[0]), [float(v) for v in r[1:5]], atol=1e-9)
             assert d.detections[0].results[0].hypothesis.class_id == "target"
         else:
             assert d.detections == []                          # lost: no detection, as the node
