@@ -13,8 +13,9 @@ import pytest
 from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
 from helpers import detection_box
 
-from iemd_ros.bag_io import BagWriter, header
-from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag, write_gt
+from iemd_ros.bag_io import BagWriter
+from iemd_ros.bag_make import (DEFAULT_TOPICS, _camera_info_msg, _image_msg, _imu_msg, source_from_folder, write_bag,
+                                 write_gt)
 from iemd_ros.cli import split_ros_args
 from iemd_ros.metrics import iou, score_sequence
 from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
@@ -140,10 +141,9 @@ def _bag_with(path, *, image_topics=("/cam/image",), imu=False, info=False, bad_
             ts = int(seq.frame_stamps_ns[k])
             f = seq.frames[k]
             for topic in image_topics:
-                step = 960 if k != bad_step_at else 900
-                msg = bag.msg("sensor_msgs/msg/Image")(header=header(bag, topic, ts, "cam"), height=240, width=320,
-                                                       encoding="bgr8", is_bigendian=0, step=step,
-                                                       data=f.reshape(-1))
+                msg = _image_msg(bag, topic, ts, "cam", f, "bgr8")         # 240x320, step 960
+                if k == bad_step_at:
+                    msg.step = 900                                          # shorter than one bgr8 row
                 bag.write(topic, ts, msg)
 
 
@@ -250,9 +250,7 @@ def test_first_images_malformed(seq, tmp_path, capsys):
     assert res.results[1].box == tuple(seq.gt_boxes[1])
     with BagWriter(tmp_path / "allbad", "mcap") as bag:
         bag.add_topic("/cam", "sensor_msgs/msg/Image")
-        bag.write("/cam", 5, bag.msg("sensor_msgs/msg/Image")(header=header(bag, "/cam", 5, "c"), height=2, width=2,
-                                                              encoding="yuv422", is_bigendian=0, step=4,
-                                                              data=np.zeros(8, np.uint8)))
+        bag.write("/cam", 5, _image_msg(bag, "/cam", 5, "c", np.zeros((2, 2, 2), np.uint8), "yuv422"))  # step 4
     assert main([str(tmp_path / "allbad"), "--init", "0,0,1,1", "--csv", str(tmp_path / "o.csv")]) == 2
     err = capsys.readouterr().err
     assert "could be decoded" in err and "unsupported image encoding 'yuv422'" in err
@@ -261,7 +259,6 @@ def test_first_images_malformed(seq, tmp_path, capsys):
 def test_imu_wait_is_bag_time(seq, tmp_path):
     """A frame waits for the gyro at most imu_wait_ms of bag (log) time: an IMU logged 40 ms after its
     stamp is too late for the default 15 ms (no prior), in time for 100 ms (prior on every frame)."""
-    from iemd_ros.bag_make import _camera_info_msg, _image_msg, _imu_msg
     from iemd_ros.pipeline import PipelineConfig
 
     t_cam = seq.gyro_t_ns - seq.time_offset_ns
