@@ -84,17 +84,12 @@ class Driver:
         self.cond = threading.Condition()
         self.detections: list[Detection2DArray] = []
         self.diagnostics: list[DiagnosticArray] = []
-        n.create_subscription(Detection2DArray, "detections", self._on_det, 100)
-        n.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 100)
+        n.create_subscription(Detection2DArray, "detections", lambda m: self._record(self.detections, m), 100)
+        n.create_subscription(DiagnosticArray, "/diagnostics", lambda m: self._record(self.diagnostics, m), 100)
 
-    def _on_det(self, msg):
+    def _record(self, received: list, msg) -> None:
         with self.cond:
-            self.detections.append(msg)
-            self.cond.notify_all()
-
-    def _on_diag(self, msg):
-        with self.cond:
-            self.diagnostics.append(msg)
+            received.append(msg)
             self.cond.notify_all()
 
     def wait_for(self, predicate, timeout: float) -> bool:
@@ -131,6 +126,15 @@ class Driver:
 
     def publish_imu(self, t_ns: int, w) -> None:
         self.imu_pub.publish(imu_msg(t_ns, w))
+
+    def publish_imu_until(self, seq, t_cam_ns: int, sent: int = 0) -> int:
+        """Publish ``seq``'s gyro samples from index ``sent`` up to the IMU time of the frame stamped
+        ``t_cam_ns`` (+5 ms), as a real IMU stream would; returns the index of the next sample."""
+        t_imu = t_cam_ns + seq.time_offset_ns + 5_000_000
+        while sent < len(seq.gyro_t_ns) and seq.gyro_t_ns[sent] <= t_imu:
+            self.publish_imu(int(seq.gyro_t_ns[sent]), seq.gyro[sent])
+            sent += 1
+        return sent
 
     def publish_camera_info(self, seq, k=None) -> None:
         msg = CameraInfo()
