@@ -1,6 +1,5 @@
 """iemd-replay: deterministic CSV, outputs (bag with detections + diagnostics, MP4, metrics), topic
 selection, ROS 1 vs converted ROS 2 vs direct ROS 2 bags, bad input (exit 2, one line), no IMU."""
-import csv
 import os
 import shutil
 import subprocess
@@ -11,7 +10,7 @@ import cv2
 import numpy as np
 import pytest
 from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
-from helpers import detection_box
+from helpers import REPO, cli_error, csv_boxes, csv_rows, detection_box, run_module
 
 from iemd_ros.bag_io import BagWriter
 from iemd_ros.bag_make import (DEFAULT_TOPICS, _camera_info_msg, _image_msg, _imu_msg, source_from_folder, write_bag,
@@ -20,7 +19,6 @@ from iemd_ros.cli import split_ros_args
 from iemd_ros.metrics import iou, score_sequence
 from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
 
-REPO = Path(__file__).resolve().parents[1]
 N = 10
 
 
@@ -41,11 +39,6 @@ def _init(seq) -> str:
     return ",".join(repr(float(v)) for v in seq.gt_boxes[0])
 
 
-def _rows(path):
-    with open(path, newline="") as f:
-        return list(csv.reader(f))
-
-
 def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     argv = [str(bags / "shaky"), "--init", _init(seq)]
     assert main(argv + ["--csv", str(tmp_path / "a.csv"), "--out-bag", str(tmp_path / "out"),
@@ -54,12 +47,12 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     assert main(argv + ["--csv", str(tmp_path / "b.csv")]) == 0
     a, b = (tmp_path / "a.csv").read_bytes(), (tmp_path / "b.csv").read_bytes()
     assert a == b                                              # same bag twice -> identical CSV
-    rows = _rows(tmp_path / "a.csv")
+    rows = csv_rows(tmp_path / "a.csv")
     assert tuple(rows[0]) == CSV_HEADER and len(rows) == N + 1   # one row per image
     assert [int(r[0]) for r in rows[1:]] == seq.frame_stamps_ns.tolist()
     assert rows[1][6] == "init" and rows[1][5] == "" and [float(v) for v in rows[1][1:5]] == seq.gt_boxes[0].tolist()
     assert all(r[6] in ("tracking", "lost") and float(r[5]) >= 0 for r in rows[2:])
-    boxes = np.array([[float(v) for v in r[1:5]] for r in rows[1:]])
+    boxes = csv_boxes(tmp_path / "a.csv")
     # the gyro prior keeps the target under this shake (IoU > 0.3 on every frame)
     assert iou(boxes, seq.gt_boxes).min() > 0.3
     # --gt prints the evaluation table with the scores of the CSV's boxes
@@ -127,7 +120,7 @@ def test_ros1_converted_matches_ros2_desk(imu_root, tmp_path):
         assert main([str(tmp_path / name), "--init", init, "--csv", str(csvs[name])]) == 0
     ref = csvs["desk_ros2"].read_bytes()
     assert csvs["desk_conv"].read_bytes() == ref and csvs["desk.bag"].read_bytes() == ref
-    assert len(_rows(csvs["desk_ros2"])) == 9
+    assert len(csv_rows(csvs["desk_ros2"])) == 9
 
 
 def _bag_with(path, *, image_topics=("/cam/image",), imu=False, info=False, bad_step_at=None, n=4, seq=None):
@@ -152,7 +145,7 @@ def test_no_imu_warns_and_tracks_without_gyro(seq, tmp_path, capsys):
     assert main([str(tmp_path / "noimu"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 0
     err = capsys.readouterr().err
     assert "warning" in err and "no sensor_msgs/msg/Imu topic" in err and "without the gyro prior" in err
-    assert len(_rows(tmp_path / "o.csv")) == 5
+    assert len(csv_rows(tmp_path / "o.csv")) == 5
     # IMU but no camera info: also a warning, no prior
     res = replay(tmp_path / "noimu", seq.gt_boxes[0], warn=lambda s: None)
     assert res.gyro_used == 0 and res.warnings
@@ -160,12 +153,11 @@ def test_no_imu_warns_and_tracks_without_gyro(seq, tmp_path, capsys):
 
 def test_topic_selection_and_malformed_image(seq, tmp_path, capsys):
     _bag_with(tmp_path / "two", image_topics=("/a/image", "/b/image"), seq=seq, bad_step_at=2)
-    assert main([str(tmp_path / "two"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "2 sensor_msgs/msg/Image topics" in err and "--image-topic" in err and err.count("\n") == 0
+    err = cli_error(main, [str(tmp_path / "two"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")], capsys)
+    assert "2 sensor_msgs/msg/Image topics" in err and "--image-topic" in err
     assert main([str(tmp_path / "two"), "--init", _init(seq), "--image-topic", "/b/image",
                  "--csv", str(tmp_path / "o.csv")]) == 0
-    rows = _rows(tmp_path / "o.csv")
+    rows = csv_rows(tmp_path / "o.csv")
     assert [r[6] for r in rows[1:]][2] == "malformed" and rows[3][1] == ""   # the bad image: a row, no box
     assert rows[4][6] in ("tracking", "lost")                                 # and tracking goes on
 
@@ -202,9 +194,7 @@ def test_bad_input(seq, bags, tmp_path, capsys):
     ]
     for argv, text in cases:
         csv_path = tmp_path / "o.csv"
-        assert main(argv + ["--csv", str(csv_path)]) == 2, argv
-        err = capsys.readouterr().err.strip()
-        assert err.startswith("iemd-replay: error:") and err.count("\n") == 0 and text in err, (argv, err)
+        assert text in cli_error(main, argv + ["--csv", str(csv_path)], capsys, "iemd-replay: error:"), argv
         assert not csv_path.exists()                        # no output on bad input
     # a ground truth of the wrong length: also exit 2
     write_gt(tmp_path / "short.txt", seq.gt_boxes[:3])
@@ -217,9 +207,7 @@ def test_cli_process_no_traceback(seq, tmp_path):
     """The real process on a truncated bag: exit status 2, one stderr line, no traceback."""
     make_bag(seq, tmp_path / "m", count=3)
     _truncate(next((tmp_path / "m").glob("*.mcap")), 0.7)
-    out = subprocess.run([sys.executable, "-m", "iemd_ros.replay", str(tmp_path / "m"), "--init", _init(seq),
-                          "--csv", str(tmp_path / "o.csv")], capture_output=True, text=True, timeout=120,
-                         env={**os.environ, "PYTHONPATH": str(REPO)})
+    out = run_module("iemd_ros.replay", str(tmp_path / "m"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"))
     assert out.returncode == 2 and "Traceback" not in out.stderr and out.stderr.strip().count("\n") == 0
     assert "truncated or corrupt" in out.stderr
 
