@@ -5,15 +5,13 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
+from bag_fixtures import IMG, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
 from helpers import REPO, cli_error, run_module
 
 from iemd_ros.bag_io import custom_data, open_bag
-from iemd_ros.bag_make import DEFAULT_TOPICS, main, source_from_folder, write_bag
+from iemd_ros.bag_make import main, source_from_folder, write_bag
 from iemd_ros.otb import load_sequence, parse_groundtruth
 from iemd_ros.recordings import load_recording
-
-IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT_TOPICS["imu"]
 
 
 @pytest.fixture(scope="module")

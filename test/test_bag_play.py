@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 import pytest
-from bag_fixtures import make_bag, shaky_sequence
+from bag_fixtures import IMG, IMU, INFO, make_bag, shaky_sequence
 from helpers import cli_error, detection_box
 
 rclpy = pytest.importorskip("rclpy")
@@ -26,13 +26,12 @@ from ros_harness import spinning  # noqa: E402
 from sensor_msgs.msg import CameraInfo, Image, Imu  # noqa: E402
 from vision_msgs.msg import Detection2DArray  # noqa: E402
 
-from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag  # noqa: E402
+from iemd_ros.bag_make import source_from_folder, write_bag  # noqa: E402
 from iemd_ros.bag_play import main, play  # noqa: E402
 from iemd_ros.conversions import stamp_ns  # noqa: E402
 from iemd_ros.pipeline import PipelineConfig  # noqa: E402
 from iemd_ros.replay import replay  # noqa: E402
 
-IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT_TOPICS["imu"]
 BOX_TOL_PX = 1e-6
 LIVE_RATE = 0.05  # the node must keep up on a loaded 2-core machine (~100-300 ms per update)
 IMU_WAIT_MS = 1000.0

@@ -113,7 +113,7 @@ def test_ros1_converted_matches_ros2_desk(imu_root, tmp_path):
     conv_msgs = read_all(tmp_path / "desk_conv")
     info = by_topic(conv_msgs, DEFAULT_TOPICS["camera_info"])[0]
     assert hasattr(info, "k") and not hasattr(info, "K")        # ROS 2 field names after conversion
-    init = ",".join(repr(float(v)) for v in src.gt_boxes[0])
+    init = _init(src)
     csvs = {}
     for name in ("desk_ros2", "desk_conv", "desk.bag"):
         csvs[name] = tmp_path / f"{name}.csv"
