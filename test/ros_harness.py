@@ -23,11 +23,16 @@ from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp
 FRAME_ID = "synthetic_cam"
 
 
+def stamp_header(header, t_ns: int, frame_id: str = FRAME_ID) -> None:
+    """Set a std_msgs/Header to ``frame_id`` and the stamp ``t_ns``."""
+    header.frame_id = frame_id
+    header.stamp.sec, header.stamp.nanosec = ns_to_stamp(t_ns)
+
+
 def imu_msg(t_ns: int, w) -> Imu:
     """A sensor_msgs/Imu stamped ``t_ns`` (frame "imu") with angular velocity ``w`` (3 values, rad/s)."""
     msg = Imu()
-    msg.header.frame_id = "imu"
-    msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+    stamp_header(msg.header, t_ns, "imu")
     msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in w)
     return msg
 
@@ -116,8 +121,7 @@ class Driver:
     # ---------------------------------------------------------------- publishing
     def publish_image(self, frame, t_ns: int, **override) -> None:
         msg = Image()
-        msg.header.frame_id = FRAME_ID
-        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+        stamp_header(msg.header, t_ns)
         f = {**array_to_image_fields(frame), **override}
         msg.encoding, msg.height, msg.width, msg.step, msg.is_bigendian = (f["encoding"], f["height"], f["width"],
                                                                            f["step"], f["is_bigendian"])
@@ -147,8 +151,7 @@ class Driver:
 
     def publish_init(self, box, t_ns: int) -> None:
         msg = Detection2D()
-        msg.header.frame_id = FRAME_ID
-        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+        stamp_header(msg.header, t_ns)
         c = msg.bbox.center.position
         c.x, c.y, msg.bbox.size_x, msg.bbox.size_y = box_to_bbox(box)
         self.init_pub.publish(msg)
