@@ -23,11 +23,16 @@ from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp
 FRAME_ID = "synthetic_cam"
 
 
+def stamp_header(header, t_ns: int, frame_id: str = FRAME_ID) -> None:
+    """Set a std_msgs/Header to ``frame_id`` and the stamp ``t_ns``."""
+    header.frame_id = frame_id
+    header.stamp.sec, header.stamp.nanosec = ns_to_stamp(t_ns)
+
+
 def imu_msg(t_ns: int, w) -> Imu:
     """A sensor_msgs/Imu stamped ``t_ns`` (frame "imu") with angular velocity ``w`` (3 values, rad/s)."""
     msg = Imu()
-    msg.header.frame_id = "imu"
-    msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+    stamp_header(msg.header, t_ns, "imu")
     msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in w)
     return msg
 
@@ -84,17 +89,12 @@ class Driver:
         self.cond = threading.Condition()
         self.detections: list[Detection2DArray] = []
         self.diagnostics: list[DiagnosticArray] = []
-        n.create_subscription(Detection2DArray, "detections", self._on_det, 100)
-        n.create_subscription(DiagnosticArray, "/diagnostics", self._on_diag, 100)
+        n.create_subscription(Detection2DArray, "detections", lambda m: self._record(self.detections, m), 100)
+        n.create_subscription(DiagnosticArray, "/diagnostics", lambda m: self._record(self.diagnostics, m), 100)
 
-    def _on_det(self, msg):
+    def _record(self, received: list, msg) -> None:
         with self.cond:
-            self.detections.append(msg)
-            self.cond.notify_all()
-
-    def _on_diag(self, msg):
-        with self.cond:
-            self.diagnostics.append(msg)
+            received.append(msg)
             self.cond.notify_all()
 
     def wait_for(self, predicate, timeout: float) -> bool:
@@ -121,8 +121,7 @@ class Driver:
     # ---------------------------------------------------------------- publishing
     def publish_image(self, frame, t_ns: int, **override) -> None:
         msg = Image()
-        msg.header.frame_id = FRAME_ID
-        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+        stamp_header(msg.header, t_ns)
         f = {**array_to_image_fields(frame), **override}
         msg.encoding, msg.height, msg.width, msg.step, msg.is_bigendian = (f["encoding"], f["height"], f["width"],
                                                                            f["step"], f["is_bigendian"])
@@ -131,6 +130,15 @@ class Driver:
 
     def publish_imu(self, t_ns: int, w) -> None:
         self.imu_pub.publish(imu_msg(t_ns, w))
+
+    def publish_imu_until(self, seq, t_cam_ns: int, sent: int = 0) -> int:
+        """Publish ``seq``'s gyro samples from index ``sent`` up to the IMU time of the frame stamped
+        ``t_cam_ns`` (+5 ms), as a real IMU stream would; returns the index of the next sample."""
+        t_imu = t_cam_ns + seq.time_offset_ns + 5_000_000
+        while sent < len(seq.gyro_t_ns) and seq.gyro_t_ns[sent] <= t_imu:
+            self.publish_imu(int(seq.gyro_t_ns[sent]), seq.gyro[sent])
+            sent += 1
+        return sent
 
     def publish_camera_info(self, seq, k=None) -> None:
         msg = CameraInfo()
@@ -143,8 +151,7 @@ class Driver:
 
     def publish_init(self, box, t_ns: int) -> None:
         msg = Detection2D()
-        msg.header.frame_id = FRAME_ID
-        msg.header.stamp.sec, msg.header.stamp.nanosec = ns_to_stamp(t_ns)
+        stamp_header(msg.header, t_ns)
         c = msg.bbox.center.position
         c.x, c.y, msg.bbox.size_x, msg.bbox.size_y = box_to_bbox(box)
         self.init_pub.publish(msg)

@@ -1,21 +1,17 @@
 """iemd-make-bag: stamps on the camera clock, IMU shifted by the recording's offset, message contents,
 formats (mcap, sqlite3, ROS 1), sources (synthetic, image folder + CSV, CMU desk, phone, OTB), bad input."""
-import subprocess
-import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
-from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
+from bag_fixtures import IMG, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
+from helpers import REPO, cli_error, run_module
 
 from iemd_ros.bag_io import custom_data, open_bag
-from iemd_ros.bag_make import DEFAULT_TOPICS, main, source_from_folder, write_bag
+from iemd_ros.bag_make import main, source_from_folder, write_bag
 from iemd_ros.otb import load_sequence, parse_groundtruth
 from iemd_ros.recordings import load_recording
-
-REPO = Path(__file__).resolve().parents[1]
-IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT_TOPICS["imu"]
 
 
 @pytest.fixture(scope="module")
@@ -165,9 +161,7 @@ def test_bad_input(seq, tmp_path, capsys):
         ([str(tmp_path / "empty"), str(tmp_path / "o3"), "--format", "zip"], "invalid choice"),
     ]
     for argv, text in cases:
-        assert main(argv) == 2
-        err = capsys.readouterr().err.strip()
-        assert err.count("\n") == 0 and text in err and err.startswith("iemd-make-bag: error:"), err
+        assert text in cli_error(main, argv, capsys, "iemd-make-bag: error:")
     # output exists / count too large / ROS 1 path without .bag, through a real source
     folder = tmp_path / "imgs"
     folder.mkdir()
@@ -177,16 +171,12 @@ def test_bad_input(seq, tmp_path, capsys):
                        ([str(folder), str(tmp_path / "o4"), "--count", "5"], "exceeds the 3 frames"),
                        ([str(folder), str(tmp_path / "o5"), "--format", "ros1"], "must be a file ending in .bag"),
                        ([str(folder), str(tmp_path / "o6"), "--imu-csv", str(tmp_path / "none.csv")], "cannot read IMU")]:
-        assert main(argv) == 2
-        err = capsys.readouterr().err.strip()
-        assert err.count("\n") == 0 and text in err, err
+        assert text in cli_error(main, argv, capsys)
     assert not (tmp_path / "o4").exists() and not (tmp_path / "o6").exists()   # no partial output
 
 
 def test_cli_process(tmp_path):
     """The real process: exit status 2 and one line, no traceback."""
-    out = subprocess.run([sys.executable, "-m", "iemd_ros.bag_make", str(tmp_path / "missing"), str(tmp_path / "o")],
-                         capture_output=True, text=True, cwd=REPO, timeout=120,
-                         env={**__import__("os").environ, "PYTHONPATH": str(REPO)})
+    out = run_module("iemd_ros.bag_make", str(tmp_path / "missing"), str(tmp_path / "o"), cwd=REPO)
     assert out.returncode == 2 and "Traceback" not in out.stderr
     assert out.stderr.strip().count("\n") == 0 and "is not a folder" in out.stderr

@@ -14,7 +14,8 @@ import time
 
 import numpy as np
 import pytest
-from bag_fixtures import make_bag, shaky_sequence
+from bag_fixtures import IMG, IMU, INFO, make_bag, shaky_sequence
+from helpers import cli_error, detection_box
 
 rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
@@ -25,13 +26,12 @@ from ros_harness import spinning  # noqa: E402
 from sensor_msgs.msg import CameraInfo, Image, Imu  # noqa: E402
 from vision_msgs.msg import Detection2DArray  # noqa: E402
 
-from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag  # noqa: E402
+from iemd_ros.bag_make import source_from_folder, write_bag  # noqa: E402
 from iemd_ros.bag_play import main, play  # noqa: E402
-from iemd_ros.conversions import bbox_to_box, stamp_ns  # noqa: E402
+from iemd_ros.conversions import stamp_ns  # noqa: E402
 from iemd_ros.pipeline import PipelineConfig  # noqa: E402
 from iemd_ros.replay import replay  # noqa: E402
 
-IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT_TOPICS["imu"]
 BOX_TOL_PX = 1e-6
 LIVE_RATE = 0.05  # the node must keep up on a loaded 2-core machine (~100-300 ms per update)
 IMU_WAIT_MS = 1000.0
@@ -131,8 +131,7 @@ def _compare(live: dict, offline, counters) -> tuple[int, int]:
         m = live[r.stamp_ns]
         if k == 0 or r.tracking:
             assert len(m.detections) == 1, f"frame {k}: offline {r.state}, live published nothing"
-            b = m.detections[0].bbox
-            box = bbox_to_box(b.center.position.x, b.center.position.y, b.size_x, b.size_y)
+            box = detection_box(m.detections[0])
             np.testing.assert_allclose(box, r.box, rtol=0, atol=BOX_TOL_PX, err_msg=f"frame {k}")
             assert m.detections[0].results[0].hypothesis.score == pytest.approx(r.score, rel=1e-9, abs=1e-12)
         else:
@@ -171,9 +170,7 @@ def test_cli_bad_input(tmp_path, capsys):
     for argv, text in [([str(tmp_path / "missing")], "does not exist"),
                        ([str(tmp_path), "--rate", "0"], "--rate must be > 0"),
                        ([str(tmp_path), "--remap", "a"], "FROM:=TO")]:
-        assert main(argv) == 2
-        err = capsys.readouterr().err.strip()
-        assert err.startswith("iemd-play: error:") and err.count("\n") == 0 and text in err, err
+        assert text in cli_error(main, argv, capsys, "iemd-play: error:")
     seq = shaky_sequence(2, render=True)
     make_bag(seq, tmp_path / "b")
     assert main([str(tmp_path / "b"), "--topics", "/nope"]) == 2

@@ -2,13 +2,9 @@
 import cv2
 import numpy as np
 import pytest
+from helpers import DESK_D, DESK_INFO, DESK_K, DESK_K_DATA
 
 from iemd_ros.camera import CameraModel
-
-DESK = dict(image_width=640, image_height=480,
-            camera_matrix=dict(rows=3, cols=3, data=[570.246, -0.100721, 309.408, 0, 569.324, 217.996, 0, 0, 1]),
-            distortion_model="plumb_bob", distortion_coefficients=dict(rows=1, cols=5, data=[-0.346217, 0.128289, 0, 0, 0]))
-DESK_K = np.reshape(DESK["camera_matrix"]["data"], (3, 3))
 
 
 def grid(w, h, step=4):
@@ -16,9 +12,9 @@ def grid(w, h, step=4):
     return np.stack([u.ravel(), v.ravel()], 1)
 
 
-@pytest.mark.parametrize("D", [[-0.346217, 0.128289, 0, 0, 0], [-0.2, 0.05, 0.001, -0.002, 0.01]])
+@pytest.mark.parametrize("D", [DESK_D, [-0.2, 0.05, 0.001, -0.002, 0.01]])
 def test_distortion_round_trip_inside_the_image(D):
-    cam = CameraModel.from_camera_info({**DESK, "distortion_coefficients": {"data": D}})
+    cam = CameraModel.from_camera_info({**DESK_INFO, "distortion_coefficients": {"data": D}})
     raw = grid(640, 480)
     und = cam.undistort_points(raw)
     assert np.all(np.isfinite(und))
@@ -56,7 +52,7 @@ def test_undistort_points_is_nan_where_the_lens_is_not_invertible():
 
 
 def test_skew_is_honoured():
-    cam = CameraModel.from_camera_info(DESK)
+    cam = CameraModel.from_camera_info(DESK_INFO)
     p = cam.distort_points(np.array([[100.0, 400.0]]))
     x = np.linalg.solve(cam.K, [100.0, 400.0, 1.0])
     r2 = x[0] ** 2 + x[1] ** 2
@@ -65,7 +61,7 @@ def test_skew_is_honoured():
 
 
 def test_camera_info_variants_and_errors(tmp_path):
-    msg = dict(width=640, height=480, k=DESK["camera_matrix"]["data"], d=[-0.3, 0.1, 0, 0, 0],
+    msg = dict(width=640, height=480, k=DESK_K_DATA, d=[-0.3, 0.1, 0, 0, 0],
                distortion_model="plumb_bob")
     cam = CameraModel.from_camera_info(msg)
     assert (cam.width, cam.height) == (640, 480) and cam.D[0] == -0.3
@@ -88,7 +84,7 @@ def test_camera_info_variants_and_errors(tmp_path):
 
 
 def test_undistort_image_straightens_a_distorted_line():
-    cam = CameraModel.from_camera_info(DESK)
+    cam = CameraModel.from_camera_info(DESK_INFO)
     und_line = np.stack([np.linspace(40, 600, 400), np.full(400, 60.0)], 1)      # straight in the pinhole image
     raw_line = cam.distort_points(und_line)
     img = np.zeros((480, 640), np.uint8)

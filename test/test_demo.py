@@ -1,8 +1,7 @@
 """iemd-demo: generates the shaky-camera bag, replays it with and without gyro, prints the table and
 writes the plot -- with no data from ../shared."""
-import csv
-
 import numpy as np
+from helpers import PNG_SIGNATURE, csv_boxes
 
 from iemd_ros.demo import main
 from iemd_ros.metrics import iou
@@ -12,22 +11,16 @@ from iemd_ros.replay import replay
 N = 12
 
 
-def _boxes(path):
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))[1:]
-    return np.array([[float(v) for v in r[1:5]] for r in rows])
-
-
 def test_demo_end_to_end(tmp_path, capsys):
     out = tmp_path / "demo"
     assert main(["--out", str(out), "--frames", str(N)]) == 0
     text = capsys.readouterr().out
     png = out / "demo.png"
-    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 20_000
+    assert png.read_bytes()[:8] == PNG_SIGNATURE and png.stat().st_size > 20_000
     assert f"plot: {png}" in text
     gt, _ = parse_groundtruth(out / "ground_truth.txt", with_flags=True)
     assert gt.shape == (N, 4)
-    g, ng = _boxes(out / "replay_gyro.csv"), _boxes(out / "replay_no_gyro.csv")
+    g, ng = csv_boxes(out / "replay_gyro.csv"), csv_boxes(out / "replay_no_gyro.csv")
     assert len(g) == len(ng) == N
     ao_g, ao_ng = iou(g, gt).mean(), iou(ng, gt).mean()
     # the table's rows are the scores of these CSVs; with the gyro prior the target is kept
@@ -39,4 +32,4 @@ def test_demo_end_to_end(tmp_path, capsys):
     np.testing.assert_array_equal(again.boxes, g)
     # re-running replaces the outputs (no "exists already")
     assert main(["--out", str(out), "--frames", "3"]) == 0
-    assert len(_boxes(out / "replay_gyro.csv")) == 3
+    assert len(csv_boxes(out / "replay_gyro.csv")) == 3

@@ -1,20 +1,16 @@
 """iemd-eval end to end (iemd_ros.evaluation): protocol wiring on synthetic data, CLI on real OTB frames."""
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
+from helpers import PNG_SIGNATURE, run_module
 
 from iemd_ros import evaluation
 from iemd_ros.evaluation import main, make_tracker, run_tracker
 from iemd_ros.otb import load_sequence
 
-REPO = Path(__file__).resolve().parents[1]
-PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 # Measured on Car4 frames 1-20 (OpenCV 5.0.0 contrib): CSRT average overlap 85.8 %, KCF 87.9 %.
 CSRT_CAR4_20_MIN_OVERLAP = 0.75
 
@@ -136,9 +132,7 @@ def test_bad_arguments_exit_2_one_line(argv, match, capsys):
 
 
 def test_bad_argument_subprocess_no_traceback(tmp_path):
-    env = dict(os.environ, PYTHONPATH=str(REPO))
-    proc = subprocess.run([sys.executable, "-m", "iemd_ros.evaluation", str(tmp_path), "--trackers", "kcf"],
-                          capture_output=True, text=True, env=env, timeout=60)
+    proc = run_module("iemd_ros.evaluation", str(tmp_path), "--trackers", "kcf", timeout=60)
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert "holds no OTB sequence" in proc.stderr

@@ -1,6 +1,7 @@
 """Gradients of the EMD with respect to the window position (eqs. 9-10 and the envelope form)."""
 import numpy as np
 import pytest
+from helpers import shifted, texture
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
@@ -10,22 +11,12 @@ from iemd_ros.emd import ground_distance, solve_emd, spatial_distance
 from iemd_ros.histogram import candidate_weights
 
 
-def smooth_texture(seed=0, shape=(240, 320)):
-    import cv2
-
-    rng = np.random.default_rng(seed)
-    noise = rng.uniform(0, 255, (shape[0] // 4, shape[1] // 4)).astype(np.float32)
-    img = cv2.resize(noise, (shape[1], shape[0]), interpolation=cv2.INTER_CUBIC)
-    return np.clip(img, 0, 255).astype(np.uint8)
-
-
 @pytest.fixture
 def model_setup():
     import cv2
 
-    frame0 = smooth_texture()
-    shift = np.float32([[1, 0, 2.3], [0, 1, -1.6]])
-    frame1 = cv2.warpAffine(frame0, shift, (frame0.shape[1], frame0.shape[0]), borderMode=cv2.BORDER_REFLECT)
+    frame0 = texture(blob=4)
+    frame1 = shifted(frame0, 2.3, -1.6, cv2.INTER_LINEAR)
     tracker = IemdTracker(TrackerConfig())
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
@@ -91,11 +82,8 @@ def test_paper_gradient_is_the_derivative_through_the_weights_only(model_setup):
 
 def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     """The gradient Algorithm 1 needs: of the EMD of the candidate re-sampled at each position."""
-    import cv2
-
-    frame0 = smooth_texture(seed=4)
-    frame1 = cv2.warpAffine(frame0, np.float32([[1, 0, 1.3], [0, 1, 0.7]]), (frame0.shape[1], frame0.shape[0]),
-                            flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
+    frame0 = texture(seed=4, blob=4)
+    frame1 = shifted(frame0, 1.3, 0.7)
     tracker = IemdTracker(TrackerConfig(gradient="appearance"))
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)

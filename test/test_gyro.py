@@ -1,6 +1,7 @@
 """Gyro prediction: homography direction, lens-aware box mapping, local prior, predictor config."""
 import numpy as np
 import pytest
+from helpers import DESK_D, DESK_K
 
 from iemd_ros.boxes import box_centre
 from iemd_ros.camera import CameraModel
@@ -10,9 +11,6 @@ from iemd_ros.imu import Coverage
 from iemd_ros.metrics import iou
 from iemd_ros.rotation import so3_exp
 from iemd_ros.synthetic import generate
-
-DESK_K = np.array([[570.246, -0.100721, 309.408], [0, 569.324, 217.996], [0, 0, 1]])
-DESK_D = [-0.346217, 0.128289, 0, 0, 0]
 
 
 def run_predictor(seq, config=None, box_source="gt"):

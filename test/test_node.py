@@ -11,11 +11,12 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
+from helpers import bbox_values  # noqa: E402
 from ros_harness import FRAME_ID, Driver, imu_msg, level, spinning, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
 
-from iemd_ros.conversions import image_to_array, stamp_ns  # noqa: E402
+from iemd_ros.conversions import image_from_msg, stamp_ns  # noqa: E402
 from iemd_ros.boxes import box_centre  # noqa: E402
 from iemd_ros.node import TrackerNode  # noqa: E402
 from iemd_ros.synthetic import generate  # noqa: E402
@@ -43,25 +44,15 @@ def tracker_and_driver(ctx, **params):
         driver.node.destroy_node()
 
 
-def _imu_until(driver, seq, t_cam_ns, sent):
-    """Publish the gyro samples up to the frame's IMU time (+5 ms), as a real IMU stream would."""
-    t_imu = t_cam_ns + seq.time_offset_ns + 5_000_000
-    while sent < len(seq.gyro_t_ns) and seq.gyro_t_ns[sent] <= t_imu:
-        driver.publish_imu(int(seq.gyro_t_ns[sent]), seq.gyro[sent])
-        sent += 1
-    return sent
-
-
 def _boxes(arr):
-    return [(d.bbox.center.position.x, d.bbox.center.position.y, d.bbox.size_x, d.bbox.size_y, d)
-            for d in arr.detections]
+    return [(*bbox_values(d.bbox), d) for d in arr.detections]
 
 
 def test_detections_follow_the_synthetic_target_at_30hz(ctx, seq):
     stamps = [int(s) for s in seq.frame_stamps_ns]
     with tracker_and_driver(ctx, imu_wait_ms=200.0) as (node, drv):   # generous: the machine may be loaded
         drv.publish_camera_info(seq)
-        sent = _imu_until(drv, seq, stamps[0], 0)
+        sent = drv.publish_imu_until(seq, stamps[0])
         drv.publish_image(seq.frames[0], stamps[0])
         assert drv.wait_for(lambda: any(stamp_ns(d.header) == stamps[0] for d in drv.detections), 10.0)
         assert not drv.detections[-1].detections                    # not initialized yet: empty array
@@ -71,7 +62,7 @@ def test_detections_follow_the_synthetic_target_at_30hz(ctx, seq):
         t0 = time.monotonic()
         for k in range(1, N):                                       # real time, 30 Hz
             time.sleep(max(0.0, t0 + k / seq.config.fps - time.monotonic()))
-            sent = _imu_until(drv, seq, stamps[k], sent)
+            sent = drv.publish_imu_until(seq, stamps[k], sent)
             drv.publish_image(seq.frames[k], stamps[k])
         assert drv.wait_for(lambda: any(stamp_ns(d.header) == stamps[-1] for d in drv.detections), 10.0)
         dets = drv.detections_since(start)
@@ -115,7 +106,7 @@ def test_reset_init_topic_and_initial_box_parameter(ctx, seq):
     s = [int(v) for v in seq.frame_stamps_ns]
     with tracker_and_driver(ctx) as (node, drv):
         drv.publish_camera_info(seq)
-        _imu_until(drv, seq, s[5], 0)
+        drv.publish_imu_until(seq, s[5])
         box0 = [float(v) for v in seq.gt_boxes[0]]
         res = drv.set_parameters(initial_box=box0)
         assert res[0].successful, res[0].reason
@@ -154,7 +145,7 @@ def test_reset_init_topic_and_initial_box_parameter(ctx, seq):
         assert drv.wait_for(lambda: any(stamp_ns(m.header) == s[4] for m in debug), 10)
         img = next(m for m in debug if stamp_ns(m.header) == s[4])
         assert (img.encoding, img.width, img.height, img.header.frame_id) == ("bgr8", 320, 240, FRAME_ID)
-        pix = image_to_array(img.encoding, img.height, img.width, img.step, img.data)
+        pix = image_from_msg(img)
         assert np.all(pix == (0, 200, 0), axis=2).sum() > 100              # the box outline
         assert np.any(pix != seq.frames[4])
         # a stamp matching no buffered frame is refused with an explanation

@@ -12,7 +12,8 @@ import pytest
 rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 from ament_index_python.packages import PackageNotFoundError, get_package_prefix  # noqa: E402
-from ros_harness import Driver, isolated_ros_env, spinning  # noqa: E402
+from helpers import bbox_values  # noqa: E402
+from ros_harness import Driver, isolated_ros_env, ros_context, spinning  # noqa: E402
 
 from iemd_ros.conversions import stamp_ns  # noqa: E402
 from iemd_ros.synthetic import generate  # noqa: E402
@@ -73,23 +74,18 @@ def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable, st
     seq = generate(n_frames=20, max_rate_deg_s=60.0, seed=5)
     s = [int(v) for v in seq.frame_stamps_ns]
     box0 = ",".join(f"{v:.3f}" for v in seq.gt_boxes[0])
-    with isolated_ros_env() as domain:
-        env = {**env, "ROS_DOMAIN_ID": str(domain), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+    with ros_context() as context:                 # isolated domain, localhost-only discovery
+        env = {**env, "ROS_DOMAIN_ID": str(context.get_domain_id()), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
         proc = _start(exe, ["--ros-args", "--params-file", str(params), "-r", "image:=/cam/image_raw",
                             "-p", f"initial_box:=[{box0}]", "-p", "diagnostics_period_s:=0.2",
                             "-p", "imu_wait_ms:=200.0"], env)
-        context = rclpy.Context()
-        rclpy.init(context=context, domain_id=domain)
         try:
             drv = Driver(context, image_topic="/cam/image_raw", reliable=False)   # sensor-data QoS, as a camera
             with spinning(context, drv.node):
                 assert drv.wait_connected(30.0), "the tracker process did not show up on DDS within 30 s"
                 sent = 0
                 for k in range(len(s)):
-                    t_imu = s[k] + 5_000_000
-                    while sent < len(seq.gyro_t_ns) and seq.gyro_t_ns[sent] <= t_imu:
-                        drv.publish_imu(int(seq.gyro_t_ns[sent]), seq.gyro[sent])
-                        sent += 1
+                    sent = drv.publish_imu_until(seq, s[k], sent)       # seq.time_offset_ns is 0 here
                     # lock-step: each frame is answered before the next; best effort may lose a frame,
                     # so send it again (a repeat of a frame already processed is rejected, harmless)
                     for _ in range(3):
@@ -101,13 +97,12 @@ def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable, st
                 assert len(dets) >= len(s) // 2, f"only {len(dets)} detections for {len(s)} frames"
                 for arr in dets:
                     k = s.index(stamp_ns(arr.header))
-                    c = arr.detections[0].bbox.center.position
-                    assert np.hypot(c.x - seq.gt_centres[k][0], c.y - seq.gt_centres[k][1]) < 3.0
+                    cx, cy, _, _ = bbox_values(arr.detections[0].bbox)
+                    assert np.hypot(cx - seq.gt_centres[k][0], cy - seq.gt_centres[k][1]) < 3.0
                 st = drv.wait_status("imu", lambda x: True, 5.0)
                 assert st is not None and "gyro prior used" in st.message, st and st.message
         finally:
             drv.node.destroy_node()
-            rclpy.try_shutdown(context=context)
             out, err, stopped = stop_process(proc)
             if not stopped:
                 pytest.fail(f"tracker did not stop within 15 s of SIGINT; stderr:\n{err}")

@@ -1,6 +1,5 @@
 """iemd-replay: deterministic CSV, outputs (bag with detections + diagnostics, MP4, metrics), topic
 selection, ROS 1 vs converted ROS 2 vs direct ROS 2 bags, bad input (exit 2, one line), no IMU."""
-import csv
 import os
 import shutil
 import subprocess
@@ -11,15 +10,15 @@ import cv2
 import numpy as np
 import pytest
 from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
+from helpers import REPO, cli_error, csv_boxes, csv_rows, detection_box, run_module
 
-from iemd_ros.bag_io import BagWriter, header
-from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_folder, write_bag, write_gt
+from iemd_ros.bag_io import BagWriter
+from iemd_ros.bag_make import (DEFAULT_TOPICS, _camera_info_msg, _image_msg, _imu_msg, source_from_folder, write_bag,
+                                 write_gt)
 from iemd_ros.cli import split_ros_args
-from iemd_ros.conversions import bbox_to_box
 from iemd_ros.metrics import iou, score_sequence
 from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
 
-REPO = Path(__file__).resolve().parents[1]
 N = 10
 
 
@@ -40,11 +39,6 @@ def _init(seq) -> str:
     return ",".join(repr(float(v)) for v in seq.gt_boxes[0])
 
 
-def _rows(path):
-    with open(path, newline="") as f:
-        return list(csv.reader(f))
-
-
 def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     argv = [str(bags / "shaky"), "--init", _init(seq)]
     assert main(argv + ["--csv", str(tmp_path / "a.csv"), "--out-bag", str(tmp_path / "out"),
@@ -53,12 +47,12 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     assert main(argv + ["--csv", str(tmp_path / "b.csv")]) == 0
     a, b = (tmp_path / "a.csv").read_bytes(), (tmp_path / "b.csv").read_bytes()
     assert a == b                                              # same bag twice -> identical CSV
-    rows = _rows(tmp_path / "a.csv")
+    rows = csv_rows(tmp_path / "a.csv")
     assert tuple(rows[0]) == CSV_HEADER and len(rows) == N + 1   # one row per image
     assert [int(r[0]) for r in rows[1:]] == seq.frame_stamps_ns.tolist()
     assert rows[1][6] == "init" and rows[1][5] == "" and [float(v) for v in rows[1][1:5]] == seq.gt_boxes[0].tolist()
     assert all(r[6] in ("tracking", "lost") and float(r[5]) >= 0 for r in rows[2:])
-    boxes = np.array([[float(v) for v in r[1:5]] for r in rows[1:]])
+    boxes = csv_boxes(tmp_path / "a.csv")
     # the gyro prior keeps the target under this shake (IoU > 0.3 on every frame)
     assert iou(boxes, seq.gt_boxes).min() > 0.3
     # --gt prints the evaluation table with the scores of the CSV's boxes
@@ -74,9 +68,7 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     assert [t for topic, _, t, _ in out if topic == DETECTIONS_TOPIC] == img_log
     for k, (d, r) in enumerate(zip(dets, rows[1:])):
         if r[6] in ("tracking", "init"):
-            c = d.detections[0].bbox
-            np.testing.assert_allclose(bbox_to_box(c.center.position.x, c.center.position.y, c.size_x, c.size_y),
-                                       [float(v) for v in r[1:5]], atol=1e-9)
+            np.testing.assert_allclose(detection_box(d.detections[0]), [float(v) for v in r[1:5]], atol=1e-9)
             assert d.detections[0].results[0].hypothesis.class_id == "target"
         else:
             assert d.detections == []                          # lost: no detection, as the node
@@ -121,14 +113,14 @@ def test_ros1_converted_matches_ros2_desk(imu_root, tmp_path):
     conv_msgs = read_all(tmp_path / "desk_conv")
     info = by_topic(conv_msgs, DEFAULT_TOPICS["camera_info"])[0]
     assert hasattr(info, "k") and not hasattr(info, "K")        # ROS 2 field names after conversion
-    init = ",".join(repr(float(v)) for v in src.gt_boxes[0])
+    init = _init(src)
     csvs = {}
     for name in ("desk_ros2", "desk_conv", "desk.bag"):
         csvs[name] = tmp_path / f"{name}.csv"
         assert main([str(tmp_path / name), "--init", init, "--csv", str(csvs[name])]) == 0
     ref = csvs["desk_ros2"].read_bytes()
     assert csvs["desk_conv"].read_bytes() == ref and csvs["desk.bag"].read_bytes() == ref
-    assert len(_rows(csvs["desk_ros2"])) == 9
+    assert len(csv_rows(csvs["desk_ros2"])) == 9
 
 
 def _bag_with(path, *, image_topics=("/cam/image",), imu=False, info=False, bad_step_at=None, n=4, seq=None):
@@ -142,10 +134,9 @@ def _bag_with(path, *, image_topics=("/cam/image",), imu=False, info=False, bad_
             ts = int(seq.frame_stamps_ns[k])
             f = seq.frames[k]
             for topic in image_topics:
-                step = 960 if k != bad_step_at else 900
-                msg = bag.msg("sensor_msgs/msg/Image")(header=header(bag, topic, ts, "cam"), height=240, width=320,
-                                                       encoding="bgr8", is_bigendian=0, step=step,
-                                                       data=f.reshape(-1))
+                msg = _image_msg(bag, topic, ts, "cam", f, "bgr8")         # 240x320, step 960
+                if k == bad_step_at:
+                    msg.step = 900                                          # shorter than one bgr8 row
                 bag.write(topic, ts, msg)
 
 
@@ -154,7 +145,7 @@ def test_no_imu_warns_and_tracks_without_gyro(seq, tmp_path, capsys):
     assert main([str(tmp_path / "noimu"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 0
     err = capsys.readouterr().err
     assert "warning" in err and "no sensor_msgs/msg/Imu topic" in err and "without the gyro prior" in err
-    assert len(_rows(tmp_path / "o.csv")) == 5
+    assert len(csv_rows(tmp_path / "o.csv")) == 5
     # IMU but no camera info: also a warning, no prior
     res = replay(tmp_path / "noimu", seq.gt_boxes[0], warn=lambda s: None)
     assert res.gyro_used == 0 and res.warnings
@@ -162,12 +153,11 @@ def test_no_imu_warns_and_tracks_without_gyro(seq, tmp_path, capsys):
 
 def test_topic_selection_and_malformed_image(seq, tmp_path, capsys):
     _bag_with(tmp_path / "two", image_topics=("/a/image", "/b/image"), seq=seq, bad_step_at=2)
-    assert main([str(tmp_path / "two"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "2 sensor_msgs/msg/Image topics" in err and "--image-topic" in err and err.count("\n") == 0
+    err = cli_error(main, [str(tmp_path / "two"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")], capsys)
+    assert "2 sensor_msgs/msg/Image topics" in err and "--image-topic" in err
     assert main([str(tmp_path / "two"), "--init", _init(seq), "--image-topic", "/b/image",
                  "--csv", str(tmp_path / "o.csv")]) == 0
-    rows = _rows(tmp_path / "o.csv")
+    rows = csv_rows(tmp_path / "o.csv")
     assert [r[6] for r in rows[1:]][2] == "malformed" and rows[3][1] == ""   # the bad image: a row, no box
     assert rows[4][6] in ("tracking", "lost")                                 # and tracking goes on
 
@@ -204,9 +194,7 @@ def test_bad_input(seq, bags, tmp_path, capsys):
     ]
     for argv, text in cases:
         csv_path = tmp_path / "o.csv"
-        assert main(argv + ["--csv", str(csv_path)]) == 2, argv
-        err = capsys.readouterr().err.strip()
-        assert err.startswith("iemd-replay: error:") and err.count("\n") == 0 and text in err, (argv, err)
+        assert text in cli_error(main, argv + ["--csv", str(csv_path)], capsys, "iemd-replay: error:"), argv
         assert not csv_path.exists()                        # no output on bad input
     # a ground truth of the wrong length: also exit 2
     write_gt(tmp_path / "short.txt", seq.gt_boxes[:3])
@@ -219,9 +207,7 @@ def test_cli_process_no_traceback(seq, tmp_path):
     """The real process on a truncated bag: exit status 2, one stderr line, no traceback."""
     make_bag(seq, tmp_path / "m", count=3)
     _truncate(next((tmp_path / "m").glob("*.mcap")), 0.7)
-    out = subprocess.run([sys.executable, "-m", "iemd_ros.replay", str(tmp_path / "m"), "--init", _init(seq),
-                          "--csv", str(tmp_path / "o.csv")], capture_output=True, text=True, timeout=120,
-                         env={**os.environ, "PYTHONPATH": str(REPO)})
+    out = run_module("iemd_ros.replay", str(tmp_path / "m"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"))
     assert out.returncode == 2 and "Traceback" not in out.stderr and out.stderr.strip().count("\n") == 0
     assert "truncated or corrupt" in out.stderr
 
@@ -252,9 +238,7 @@ def test_first_images_malformed(seq, tmp_path, capsys):
     assert res.results[1].box == tuple(seq.gt_boxes[1])
     with BagWriter(tmp_path / "allbad", "mcap") as bag:
         bag.add_topic("/cam", "sensor_msgs/msg/Image")
-        bag.write("/cam", 5, bag.msg("sensor_msgs/msg/Image")(header=header(bag, "/cam", 5, "c"), height=2, width=2,
-                                                              encoding="yuv422", is_bigendian=0, step=4,
-                                                              data=np.zeros(8, np.uint8)))
+        bag.write("/cam", 5, _image_msg(bag, "/cam", 5, "c", np.zeros((2, 2, 2), np.uint8), "yuv422"))  # step 4
     assert main([str(tmp_path / "allbad"), "--init", "0,0,1,1", "--csv", str(tmp_path / "o.csv")]) == 2
     err = capsys.readouterr().err
     assert "could be decoded" in err and "unsupported image encoding 'yuv422'" in err
@@ -263,7 +247,6 @@ def test_first_images_malformed(seq, tmp_path, capsys):
 def test_imu_wait_is_bag_time(seq, tmp_path):
     """A frame waits for the gyro at most imu_wait_ms of bag (log) time: an IMU logged 40 ms after its
     stamp is too late for the default 15 ms (no prior), in time for 100 ms (prior on every frame)."""
-    from iemd_ros.bag_make import _camera_info_msg, _image_msg, _imu_msg
     from iemd_ros.pipeline import PipelineConfig
 
     t_cam = seq.gyro_t_ns - seq.time_offset_ns

@@ -4,6 +4,7 @@ import dataclasses
 import cv2
 import numpy as np
 import pytest
+from helpers import shifted, texture
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
@@ -12,17 +13,6 @@ from iemd_ros.metrics import iou
 from iemd_ros.otb import load_sequence, read_frame
 from iemd_ros.template import TemplateDictionary
 from iemd_ros.tracker import _visible_fraction
-
-
-def texture(seed=0, shape=(240, 320), blob=5):
-    rng = np.random.default_rng(seed)
-    noise = rng.uniform(0, 255, (shape[0] // blob, shape[1] // blob)).astype(np.float32)
-    return np.clip(cv2.resize(noise, (shape[1], shape[0]), interpolation=cv2.INTER_CUBIC), 0, 255).astype(np.uint8)
-
-
-def shifted(img, dx, dy):
-    m = np.float32([[1, 0, dx], [0, 1, dy]])
-    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
 
 
 @pytest.mark.parametrize("bad,match", [

@@ -228,35 +228,31 @@ def _child_env(domain_id: int) -> dict:
     return env
 
 
-def test_detection2d_array_between_processes(vm, monkeypatch, stop_process):
+def test_detection2d_array_between_processes(vm, stop_process):
     import rclpy
-    from rclpy.context import Context
     from rclpy.executors import SingleThreadedExecutor
+    from ros_harness import ros_context
 
-    domain_id = 30 + os.getpid() % 70
     topic = f"/iemd_test_{uuid.uuid4().hex[:12]}/detections"
-    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-    publisher = subprocess.Popen(
-        [sys.executable, str(Path(__file__).resolve()), "--publish", topic],
-        env=_child_env(domain_id), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    context = Context()
-    rclpy.init(context=context, domain_id=domain_id)
-    try:
-        node = rclpy.create_node("vision_msgs_test_subscriber", context=context)
-        received = []
-        node.create_subscription(vm.Detection2DArray, topic, received.append, 10)
-        executor = SingleThreadedExecutor(context=context)
-        executor.add_node(node)
-        deadline = time.monotonic() + 30.0
-        while not received and time.monotonic() < deadline and publisher.poll() is None:
-            executor.spin_once(timeout_sec=0.1)
-        # Endpoints seen in discovery (the topic name is unique: the only publisher is the child).
-        remote = node.get_publishers_info_by_topic(topic)
-        executor.shutdown()
-        node.destroy_node()
-    finally:
-        rclpy.try_shutdown(context=context)
-        out, err, _ = stop_process(publisher)
+    with ros_context() as context:                  # isolated domain, localhost-only discovery
+        publisher = subprocess.Popen(
+            [sys.executable, str(Path(__file__).resolve()), "--publish", topic],
+            env=_child_env(context.get_domain_id()), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            node = rclpy.create_node("vision_msgs_test_subscriber", context=context)
+            received = []
+            node.create_subscription(vm.Detection2DArray, topic, received.append, 10)
+            executor = SingleThreadedExecutor(context=context)
+            executor.add_node(node)
+            deadline = time.monotonic() + 30.0
+            while not received and time.monotonic() < deadline and publisher.poll() is None:
+                executor.spin_once(timeout_sec=0.1)
+            # Endpoints seen in discovery (the topic name is unique: the only publisher is the child).
+            remote = node.get_publishers_info_by_topic(topic)
+            executor.shutdown()
+            node.destroy_node()
+        finally:
+            out, err, _ = stop_process(publisher)
     assert received, f"no Detection2DArray within 30 s; publisher stderr:\n{err[-2000:]}"
     assert received[0] == build_detection_array(rclpy_class)
     assert received[0].detections[0].bbox.size_y == 128.5

@@ -1,0 +1,79 @@
+"""Plain helpers shared by several test modules (no fixtures, no ROS imports).
+
+Imported as a top-level module (``from helpers import ...``): pytest's default ``prepend`` import
+mode puts this folder, which holds conftest.py and no __init__.py, on ``sys.path``.
+"""
+from __future__ import annotations
+
+import csv
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from iemd_ros.conversions import bbox_to_box
+
+REPO = Path(__file__).resolve().parents[1]
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+# The CMU desk camera (cmu_hwangbo_desk/derived_camera_info.yaml): 640x480, a small skew, plumb_bob.
+DESK_K_DATA = (570.246, -0.100721, 309.408, 0, 569.324, 217.996, 0, 0, 1)
+DESK_D = (-0.346217, 0.128289, 0, 0, 0)
+DESK_K = np.reshape(DESK_K_DATA, (3, 3))
+DESK_K.setflags(write=False)        # CameraModel keeps the array it is given: no test may change it
+DESK_INFO = dict(image_width=640, image_height=480,
+                 camera_matrix=dict(rows=3, cols=3, data=DESK_K_DATA),
+                 distortion_model="plumb_bob", distortion_coefficients=dict(rows=1, cols=5, data=DESK_D))
+
+
+def texture(seed=0, shape=(240, 320), blob=5):
+    """A smooth random grey texture: uniform noise on a grid ``blob`` times coarser, resized (cubic)."""
+    rng = np.random.default_rng(seed)
+    noise = rng.uniform(0, 255, (shape[0] // blob, shape[1] // blob)).astype(np.float32)
+    return np.clip(cv2.resize(noise, (shape[1], shape[0]), interpolation=cv2.INTER_CUBIC), 0, 255).astype(np.uint8)
+
+
+def shifted(img, dx, dy, interpolation=cv2.INTER_CUBIC):
+    """``img`` translated by (dx, dy) px, borders reflected."""
+    m = np.float32([[1, 0, dx], [0, 1, dy]])
+    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=interpolation, borderMode=cv2.BORDER_REFLECT)
+
+
+def bbox_values(bbox) -> tuple[float, float, float, float]:
+    """A ``vision_msgs/BoundingBox2D`` (rclpy or rosbags message) -> ``(center x, center y, size_x, size_y)``."""
+    c = bbox.center.position
+    return c.x, c.y, bbox.size_x, bbox.size_y
+
+
+def detection_box(detection) -> tuple[float, float, float, float]:
+    """The tracker box ``(x, y, w, h)`` of a ``vision_msgs/Detection2D`` (by ``conversions.bbox_to_box``)."""
+    return bbox_to_box(*bbox_values(detection.bbox))
+
+
+# ---------------------------------------------------------------------------------------------- command lines
+def cli_error(main, argv, capsys, prefix: str = "") -> str:
+    """Run a CLI ``main(argv)``: it must exit with status 2 and print one stderr line (stripped) starting
+    with ``prefix``; returns that line."""
+    assert main(argv) == 2, argv
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith(prefix), (argv, err)
+    return err
+
+
+def run_module(module: str, *args: str, timeout: float = 120, **kw) -> subprocess.CompletedProcess:
+    """``python -m module args...`` as its own process on the repository's sources (text output captured)."""
+    return subprocess.run([sys.executable, "-m", module, *args], capture_output=True, text=True, timeout=timeout,
+                          env={**os.environ, "PYTHONPATH": str(REPO)}, **kw)
+
+
+def csv_rows(path) -> list[list[str]]:
+    with open(path, newline="") as f:
+        return list(csv.reader(f))
+
+
+def csv_boxes(path) -> np.ndarray:
+    """The boxes (columns 1-4, x y w h) of an iemd-replay CSV, one row per image below the header."""
+    return np.array([[float(v) for v in r[1:5]] for r in csv_rows(path)[1:]])
