@@ -20,7 +20,7 @@ import numpy as np
 from .camera import CameraModel
 from .boxes import box_centre, centre_box, check_box
 
-__all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "camera_model_from_info", "camera_model_from_msg",
+__all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
            "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
            "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
 
@@ -98,6 +98,14 @@ def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dic
     channels = 1 if frame.ndim == 2 else 3
     return dict(encoding=encoding, height=h, width=w, step=w * channels, is_bigendian=0,
                 data=np.ascontiguousarray(frame).tobytes())
+
+
+def fill_image_msg(msg, frame: np.ndarray, encoding: str | None = None):
+    """Set a ``sensor_msgs/Image``'s pixel fields from a tracker frame (:func:`array_to_image_fields`);
+    returns ``msg``.  The header is the caller's."""
+    for name, value in array_to_image_fields(frame, encoding).items():
+        setattr(msg, name, value)
+    return msg
 
 
 def camera_model_from_msg(msg) -> CameraModel:

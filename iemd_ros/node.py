@@ -42,7 +42,7 @@ from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithP
 
 from .boxes import check_box
 from .cli import one_line
-from .conversions import (CLASS_ID, DETECTION_ID, array_to_image_fields, bbox_to_box, camera_model_from_msg,
+from .conversions import (CLASS_ID, DETECTION_ID, bbox_to_box, camera_model_from_msg, fill_image_msg,
                           detection_values, image_from_msg, imu_sample, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
@@ -433,12 +433,8 @@ class TrackerNode(Node):
         if self._debug_pub.get_subscription_count() == 0 or self._stop:
             return
         canvas = draw_result(frame, result)
-        out = Image()
+        out = fill_image_msg(Image(), canvas)   # data as bytes: ~0.06 ms, a numpy array ~68 ms per VGA frame
         out.header = img.header
-        f = array_to_image_fields(canvas)
-        out.encoding, out.height, out.width, out.step, out.is_bigendian = (f["encoding"], f["height"], f["width"],
-                                                                           f["step"], f["is_bigendian"])
-        out.data = f["data"]          # bytes: ~0.06 ms, where a numpy array costs ~68 ms per VGA frame
         if self.context.ok():
             self._debug_pub.publish(out)
 

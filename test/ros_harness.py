@@ -18,7 +18,7 @@ from sensor_msgs.msg import CameraInfo, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray
 
-from iemd_ros.conversions import array_to_image_fields, box_to_bbox, ns_to_stamp
+from iemd_ros.conversions import box_to_bbox, fill_image_msg, ns_to_stamp
 
 FRAME_ID = "synthetic_cam"
 
@@ -120,12 +120,10 @@ class Driver:
 
     # ---------------------------------------------------------------- publishing
     def publish_image(self, frame, t_ns: int, **override) -> None:
-        msg = Image()
+        msg = fill_image_msg(Image(), frame)
         stamp_header(msg.header, t_ns)
-        f = {**array_to_image_fields(frame), **override}
-        msg.encoding, msg.height, msg.width, msg.step, msg.is_bigendian = (f["encoding"], f["height"], f["width"],
-                                                                           f["step"], f["is_bigendian"])
-        msg.data = f["data"]
+        for name, value in override.items():     # a malformed message on purpose
+            setattr(msg, name, value)
         self.image_pub.publish(msg)
 
     def publish_imu(self, t_ns: int, w) -> None:

@@ -7,8 +7,8 @@ import pytest
 
 from iemd_ros.boxes import box_centre, centre_box, check_box
 from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info,
-                                  detection_values, image_from_msg, image_to_array, imu_sample, ns_to_stamp,
-                                  stamp_to_ns)
+                                  detection_values, fill_image_msg, image_from_msg, image_to_array, imu_sample,
+                                  ns_to_stamp, stamp_to_ns)
 from iemd_ros.pipeline import FrameResult
 
 
@@ -79,6 +79,15 @@ def test_array_to_image_fields_round_trip(bgr):
         array_to_image_fields(bgr, "mono8")
     with pytest.raises(ValueError, match="uint8"):
         array_to_image_fields(bgr.astype(np.float32))
+
+
+def test_fill_image_msg_round_trips_through_a_real_image_message(bgr):
+    from sensor_msgs.msg import Image
+
+    for frame, enc in ((bgr, "rgb8"), (bgr[..., 1], None)):
+        msg = fill_image_msg(Image(), frame, enc)
+        assert msg.encoding == (enc or "mono8") and (msg.height, msg.width) == frame.shape[:2]
+        np.testing.assert_array_equal(image_from_msg(msg), frame)   # rgb8 comes back as BGR
 
 
 def test_camera_model_from_info():
