@@ -328,6 +328,10 @@ class TrackingPipeline:
                 self._last["imu_reason"] = f"IMU clock jumped back by {_ms(back)}: IMU buffer restarted"
                 self._predictor = predictor                   # holding the first sample on the new clock
             elif back > 0:
+                # The buffer's out_of_order count tests the same (an accepted stamp below the newest
+                # accepted one), but it restarts with every new predictor (IMU clock reset, image clock
+                # reset with the IMU still on the old clock, gyro reconfiguration: samples re-fed in
+                # order); this one counts over the pipeline's life, like the other /diagnostics counters.
                 c["imu_out_of_order"] += 1
                 self._last["imu_reason"] = f"IMU stamp went back by {_ms(back)} (sample put in order)"
             self._imu_bad_run = 0

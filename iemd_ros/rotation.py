@@ -58,20 +58,23 @@ def quat_normalize(q) -> np.ndarray:
     """Unit quaternion with a non-negative scalar part (``q`` and ``-q`` are the same rotation)."""
     q = np.asarray(q, dtype=float)
     n = np.linalg.norm(q, axis=-1, keepdims=True)
-    if np.any(n == 0) or not np.all(np.isfinite(n)):
+    if (n == 0).any() or not np.isfinite(n).all():
         raise ValueError("cannot normalize a zero or non-finite quaternion")
     q = q / n
     return np.where(q[..., :1] < 0, -q, q)
 
 
 def quat_to_rot(q) -> np.ndarray:
-    """Rotation matrix of a unit quaternion ``[m, a, b, c]`` (paper eq. 22)."""
-    m, a, b, c = np.moveaxis(quat_normalize(q), -1, 0)
-    return np.stack([
-        np.stack([1 - 2 * b * b - 2 * c * c, 2 * a * b - 2 * c * m, 2 * a * c + 2 * b * m], -1),
-        np.stack([2 * a * b + 2 * c * m, 1 - 2 * a * a - 2 * c * c, 2 * b * c - 2 * a * m], -1),
-        np.stack([2 * a * c - 2 * b * m, 2 * b * c + 2 * a * m, 1 - 2 * a * a - 2 * b * b], -1),
-    ], axis=-2)
+    """Rotation matrix of a unit quaternion ``[m, a, b, c]`` (paper eq. 22), (..., 4) -> (..., 3, 3).
+
+    The nine entries go into one array (for one quaternion they are numpy scalars: no stacking).
+    """
+    q = quat_normalize(q)
+    m, a, b, c = q.transpose(-1, *range(q.ndim - 1))
+    R = np.array([1 - 2 * b * b - 2 * c * c, 2 * a * b - 2 * c * m, 2 * a * c + 2 * b * m,
+                  2 * a * b + 2 * c * m, 1 - 2 * a * a - 2 * c * c, 2 * b * c - 2 * a * m,
+                  2 * a * c - 2 * b * m, 2 * b * c + 2 * a * m, 1 - 2 * a * a - 2 * b * b])  # (9, ...)
+    return R.transpose(*range(1, R.ndim), 0).reshape(q.shape[:-1] + (3, 3))
 
 
 def rot_to_quat(R) -> np.ndarray:

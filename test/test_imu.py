@@ -237,3 +237,67 @@ def test_real_desk_log_step_backs(imu_root):
     ti = rec.frame_imu_ns
     for k in range(0, len(ti) - 1, 37):
         np.testing.assert_allclose(buf.integrate(ti[k], ti[k + 1]).R, ref.integrate(ti[k], ti[k + 1]).R, atol=1e-14)
+
+
+def _messy_stream(n=3000, seed=7):
+    """Stamps and rates with every case the screening handles: NaN/inf, saturated, exact repeats,
+    equal stamps with other values, small and large steps back."""
+    rng = np.random.default_rng(seed)
+    t = T0 + np.cumsum(rng.integers(1, 10, n)) * MS
+    back = rng.random(n) < 0.05
+    t[back] -= rng.integers(1, 50, back.sum()) * MS
+    w = rng.normal(0.0, 2.0, (n, 3))
+    rep = np.flatnonzero(rng.random(n) < 0.03)
+    rep = rep[rep > 0]
+    t[rep] = t[rep - 1]
+    w[rep[::2]] = w[rep[::2] - 1]                            # half exact repeats, half other values
+    w[rng.random(n) < 0.02, rng.integers(0, 3)] = np.nan
+    w[rng.random(n) < 0.01, rng.integers(0, 3)] = -np.inf
+    w[rng.random(n) < 0.02, 1] = 7.5                          # at or over the limit of 6 rad/s
+    w[rng.random(n) < 0.01, 2] = -6.0
+    return t, w
+
+
+def test_one_sample_at_a_time_matches_one_batch():
+    """Statuses, counters, stored samples and the newest stamp do not depend on how the stream is cut."""
+    t, w = _messy_stream()
+    half = len(t) // 2
+    t[half + 2] = t[half - 5]                                 # arrives after the window below: late
+
+    def feed(cuts):
+        buf = ImuBuffer(max_duration_ns=2_000 * MS, saturation=6.0)
+        status = []
+        for a, b in zip(cuts[:-1], cuts[1:]):
+            if a == half:        # a frame integrated mid-stream: later samples before its end are late
+                buf.integrate(buf.t_newest_ns - 40 * MS, buf.t_newest_ns)
+            if b - a == 1:       # what the node passes: an int stamp and a rate triple
+                status.append(buf.add(int(t[a]), tuple(float(x) for x in w[a])))
+            else:
+                status.append(buf.add(t[a:b], w[a:b]))
+        return buf, np.concatenate(status)
+
+    rng = np.random.default_rng(1)
+    chunks = np.unique(np.r_[0, half, rng.integers(0, len(t), 40), len(t)])
+    runs = [feed([0, half, len(t)]), feed(list(range(len(t) + 1))), feed(list(chunks))]
+    (ref, ref_status), others = runs[0], runs[1:]
+    st = ref.stats()
+    assert min(st[k] for k in ("nan", "saturated", "duplicates", "out_of_order", "late", "dropped")) > 0
+    assert np.array_equal(ref_status == SampleStatus.ACCEPTED, np.isfinite(w).all(1) & (np.abs(w) < 6.0).all(1))
+    t_ref, w_ref = ref.samples()
+    for buf, status in others:
+        np.testing.assert_array_equal(status, ref_status)
+        assert status.dtype == ref_status.dtype
+        assert buf.stats() == st and buf.t_newest_ns == ref.t_newest_ns
+        t_got, w_got = buf.samples()
+        np.testing.assert_array_equal(t_got, t_ref)
+        np.testing.assert_array_equal(w_got, w_ref)
+
+
+def test_empty_and_all_rejected_batches_leave_the_stream_untouched():
+    buf = ImuBuffer(saturation=1.0)
+    assert buf.add(np.zeros(0, np.int64), np.zeros((0, 3))).tolist() == []
+    assert buf.add([T0, T0 + MS], [[np.nan, 0, 0], [0, 2.0, 0]]).tolist() == [SampleStatus.NOT_FINITE,
+                                                                              SampleStatus.SATURATED]
+    assert buf.t_newest_ns is None and not buf.covers(0)
+    assert buf.stats() == dict(added=2, accepted=0, nan=1, saturated=1, duplicates=0, out_of_order=0, late=0,
+                               dropped=0, stored=0)

@@ -143,6 +143,7 @@ def test_imu_validation_counts_and_explains(seq):
     assert p._predictor.buffer is not old and old.stats()["added"] == added     # the old buffer never saw them
     st = p._predictor.buffer.stats()
     assert (st["added"], st["accepted"], st["out_of_order"]) == (1, 1, 0)      # added once, to the new buffer
+    assert d["imu_out_of_order"] == 1 == old.stats()["out_of_order"]    # the pipeline's count outlives the buffer
 
 
 def test_imu_before_camera_info_is_screened_and_held(seq):

@@ -28,6 +28,22 @@ def test_exp_matches_rodrigues_and_quaternion_roundtrip():
     np.testing.assert_allclose(quat_to_rot(rot_to_quat(R)), R, atol=1e-9)
 
 
+def test_quat_to_rot_entries_and_batches():
+    """Eq. 22's layout (a quarter turn about x), normalization, and (..., 4) batches equal to one at a time."""
+    np.testing.assert_allclose(quat_to_rot([1.0, 1.0, 0.0, 0.0]), [[1, 0, 0], [0, 0, -1], [0, 1, 0]], atol=1e-15)
+    q = np.random.default_rng(3).normal(size=(5, 7, 4))
+    R = quat_to_rot(q)
+    assert R.shape == (5, 7, 3, 3) and quat_to_rot(q[0, 0]).shape == (3, 3)
+    for i in range(5):
+        np.testing.assert_array_equal(quat_to_rot(q[i]), R[i])
+        for j in range(7):
+            np.testing.assert_array_equal(quat_to_rot(q[i, j]), R[i, j])
+            np.testing.assert_array_equal(quat_to_rot(-q[i, j]), R[i, j])
+            np.testing.assert_allclose(quat_to_rot(3.0 * q[i, j]), R[i, j], atol=1e-15)
+    np.testing.assert_allclose(R @ np.swapaxes(R, -1, -2), np.broadcast_to(np.eye(3), R.shape), atol=1e-15)
+    assert quat_to_rot(np.zeros((0, 4))).shape == (0, 3, 3)
+
+
 def test_omega_matrix_is_right_multiplication_by_rate():
     """The paper's Omega(w) q equals q * (0, w): body rates, right-multiplied (eq. 21)."""
     rng = np.random.default_rng(2)
