@@ -45,7 +45,7 @@ def main():
                 start = tracker._candidate(pyramid, truth + offset, size)  # one start model for all three
                 for gradient in GRADIENTS:
                     tracker.config.gradient = gradient  # only the descent reads it
-                    state = tracker._descend(pyramid, start)
+                    state = tracker._descend(start)
                     errors[gradient].append(np.linalg.norm(state.center - truth))
                     iterations[gradient].append(state.iterations)
     print(f"starts up to {args.offset} px from the ground truth, {len(errors['paper'])} per gradient")

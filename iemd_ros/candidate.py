@@ -74,12 +74,19 @@ class CandidateModel:
         self.alpha = alpha
         self.bandwidth = bandwidth
         self.layout = layout
+        self._pyramid, self._dictionary = pyramid, dictionary
         self.template = pyramid.sample(self.center, self.size, layout.template_size, coarse, angle)
         self.eps = layout.extract(self.template)
         self.pos = layout.positions()
         self.code_weights = np.ones(len(self.eps)) if dictionary is None else dictionary.code_weights(self.eps)
         self.appearance_cost = alpha * appearance_distance(target.eps, self.eps, target.eps_sq_norms)
         self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
+
+    def at(self, center, size=None) -> "CandidateModel":
+        """The same model (frame, target, dictionary, pyramid level, orientation) at another window:
+        Algorithm 1's next iterate, or a scale variant when ``size`` is given."""
+        return CandidateModel(self._pyramid, self.layout, center, self.size if size is None else size, self.target,
+                              self._dictionary, self.alpha, self.bandwidth, self.coarse, self.angle)
 
     @cached_property
     def patch_jacobian(self) -> np.ndarray:

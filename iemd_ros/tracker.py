@@ -204,7 +204,7 @@ class IemdTracker:
             searches.append(candidate)
             if candidate.emd < best.emd:
                 best = candidate
-        final, scale, emd, scale_codings, scale_warnings = self._search_scale(pyramid, best, size)
+        final, scale, emd, scale_codings, scale_warnings = self._search_scale(best, size)
         new_center, new_size = final.center, final.size
         best_box = _box(new_center, new_size, angle)
         visible = _visible_fraction(new_center, new_size, angle, frame.shape)
@@ -289,17 +289,17 @@ class IemdTracker:
         scored, warnings = [], 0
         for start in starts:
             if self.config.coarse_to_fine:
-                coarse = self._descend(pyramid, self._candidate(pyramid, start, size, coarse=True))
+                coarse = self._descend(self._candidate(pyramid, start, size, coarse=True))
                 start, warnings = coarse.center, warnings + coarse.warnings
             model = self._candidate(pyramid, start, size)
             scored.append((model.emd()[0], model))
         winner = min(scored, key=lambda item: item[0])[1]
-        best = self._descend(pyramid, winner)  # counts the winner's solve (cached from the scoring)
+        best = self._descend(winner)  # counts the winner's solve (cached from the scoring)
         best.codings += len(scored)
         best.warnings += warnings + sum(_not_optimal(m.emd()[1]) for _, m in scored if m is not winner)
         return best
 
-    def _descend(self, pyramid: ImagePyramid, model: CandidateModel) -> _Descent:
+    def _descend(self, model: CandidateModel) -> _Descent:
         """Algorithm 1 from the window of ``model``: move against dEMD/dy while the EMD decreases.
 
         The paper moves one pixel along the gradient and stops at the first EMD
@@ -318,13 +318,12 @@ class IemdTracker:
         reaches distractors) and updates took 3x longer, so it was not kept.
         """
         cfg = self.config
-        size, coarse = model.size, bool(model.coarse)
-        half = size / 2.0
+        half = model.size / 2.0
         axes = window_axes(model.angle)
         emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
         state = _Descent(model=model, emd=emd, warnings=_not_optimal(sol))
         # The coarse stage samples one pyramid level up: its steps are twice as long.
-        level_scale = 2.0 if coarse else 1.0
+        level_scale = 2.0 if model.coarse else 1.0
         step, min_step = cfg.step_px * level_scale, cfg.min_step_px * level_scale
         while state.iterations < cfg.n_iter and step >= min_step:
             g_px = axes @ (grad / half)  # gradient with respect to image pixels
@@ -332,7 +331,7 @@ class IemdTracker:
             if not np.isfinite(norm) or norm == 0:
                 break
             state.iterations += 1
-            trial = self._candidate(pyramid, state.center - step * g_px / norm, size, coarse)
+            trial = state.model.at(state.center - step * g_px / norm)
             e_try, s_try = trial.emd()
             state.codings += 1
             state.warnings += _not_optimal(s_try)
@@ -342,7 +341,7 @@ class IemdTracker:
                 step *= 0.5
         return state
 
-    def _search_scale(self, pyramid: ImagePyramid, state: _Descent, size):
+    def _search_scale(self, state: _Descent, size):
         """Scale variants at the converged centre (paper: window enlarged/shrunk by 2%).
 
         Each variant is a candidate model of the window resampled at s * size, so it
@@ -363,7 +362,7 @@ class IemdTracker:
         for direction in (-1.0, 1.0):
             for n in range(1, n_steps + 1):
                 scale = 1.0 + direction * n * cfg.scale_step
-                model = self._candidate(pyramid, state.center, size * scale)
+                model = state.model.at(state.center, size * scale)
                 emd, sol = model.emd()
                 codings += 1
                 warnings += _not_optimal(sol)

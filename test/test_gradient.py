@@ -27,6 +27,25 @@ def model_setup():
     return tracker, model
 
 
+def test_candidate_at_is_the_same_model_at_another_window(model_setup):
+    """CandidateModel.at (Algorithm 1's next iterate, a scale variant) keeps the frame, target,
+    dictionary, pyramid level and orientation, and equals a model built at that window."""
+    tracker, model = model_setup
+    pyramid, cfg = model._pyramid, tracker.config
+    turned = CandidateModel(pyramid, tracker.layout, model.center, model.size, tracker._target, None, cfg.alpha,
+                            cfg.kernel_bandwidth, coarse=1, angle=0.3)
+    for start, dictionary in ((model, tracker.dictionary), (turned, None)):
+        center, size = start.center + (1.7, -0.4), start.size * 1.02
+        moved = start.at(center, size)
+        built = CandidateModel(pyramid, tracker.layout, center, size, tracker._target, dictionary, cfg.alpha,
+                               cfg.kernel_bandwidth, coarse=start.coarse, angle=start.angle)
+        assert (moved.coarse, moved.angle) == (start.coarse, start.angle)
+        np.testing.assert_array_equal(moved.template, built.template)
+        np.testing.assert_array_equal(moved.code_weights, built.code_weights)
+        assert moved.emd()[0] == built.emd()[0] != start.emd()[0]
+        np.testing.assert_array_equal(start.at(center).size, start.size)
+
+
 @pytest.mark.parametrize("y", [(0.0, 0.0), (0.05, -0.03)])
 def test_candidate_emd_uses_the_ground_distance(model_setup, y):
     """The model's compiled transport cost is eq. (ground distance) between the target bins and the
