@@ -22,17 +22,18 @@ def centre_box(centre, size) -> np.ndarray:
     return np.concatenate([c - (s - 1.0) / 2.0, s], axis=-1)
 
 
-def check_box(box, what: str = "box") -> tuple[float, float, float, float]:
-    """``box`` (4 numbers, or the text ``"x,y,w,h"``) as 4 floats ``(x, y, w, h)``, finite with
-    ``w, h > 0``; else ValueError naming ``what`` and quoting ``box`` as given."""
+def check_box(box, what: str = "box", shown=None) -> tuple[float, float, float, float]:
+    """``box`` as 4 floats ``(x, y, w, h)``, finite with ``w, h > 0``; else ValueError naming ``what``
+    and quoting ``shown`` (default: ``box``), e.g. the text the values were parsed from."""
+    shown = box if shown is None else shown
     try:
-        b = np.asarray(box.split(",") if isinstance(box, str) else box, dtype=float).ravel()
+        b = np.asarray(box, dtype=float).ravel()
     except (TypeError, ValueError):
         b = np.empty(0)
     if b.shape != (4,):
-        raise ValueError(f"{what} must be 4 numbers (x, y, w, h), got {box!r}")
+        raise ValueError(f"{what} must be 4 numbers (x, y, w, h), got {shown!r}")
     if not np.all(np.isfinite(b)):
-        raise ValueError(f"{what} has non-finite values: {box!r}")
+        raise ValueError(f"{what} has non-finite values: {shown!r}")
     if b[2] <= 0 or b[3] <= 0:
-        raise ValueError(f"{what} must have a positive size (w, h > 0), got {box!r}")
+        raise ValueError(f"{what} must have a positive size (w, h > 0), got {shown!r}")
     return tuple(float(v) for v in b)

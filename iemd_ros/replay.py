@@ -112,7 +112,7 @@ class ReplayResult:
 def parse_box(box) -> tuple[float, float, float, float]:
     """The init box: ``"X,Y,W,H"`` or a sequence of 4 numbers -> 4 floats (finite, w, h > 0); ValueError
     (naming ``--init``) otherwise."""
-    return check_box(box, "--init")
+    return check_box(box.split(",") if isinstance(box, str) else box, "--init", shown=box)
 
 
 def load_gt(path) -> np.ndarray:

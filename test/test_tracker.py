@@ -33,6 +33,7 @@ def test_invalid_frames_raise_value_error(bad, match):
     ((-50, 10, 20, 20), "outside"),
     ((np.nan, 10, 20, 20), "non-finite"),
     ((1, 2, 3), "4 numbers"),
+    ("10,10,20,20", "4 numbers"),   # text is iemd-replay's --init to parse, not the tracker's
 ])
 def test_invalid_boxes_raise_value_error(box, match):
     with pytest.raises(ValueError, match=match):
