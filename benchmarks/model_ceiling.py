@@ -93,7 +93,7 @@ def capture(name):
         for angle in np.linspace(0, 2 * np.pi, 8, endpoint=False):
             direction = np.array([np.cos(angle), np.sin(angle)])
             for i, distance in enumerate(CAPTURE_STARTS):
-                end = tracker._search(pyramid, centre + distance * size * direction, size).center
+                end = tracker._search(pyramid, (centre + distance * size * direction)[None], size, 0.0).center
                 converged[i] += np.linalg.norm((end - centre) / size) < 0.05
             searches += 1
     return name, 100.0 * converged / searches

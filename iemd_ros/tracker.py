@@ -108,13 +108,13 @@ class TrackResult:
 
 @dataclass
 class _Descent:
-    """Outcome of Algorithm 1 from one starting point."""
+    """Outcome of a search: the window it ended at and what it cost."""
 
     model: CandidateModel  # the window it ended at
     emd: float
     iterations: int = 0
-    codings: int = 0  # candidate models built for its trial steps (the caller counts the start's)
-    warnings: int = 0
+    codings: int = 0  # candidate models built (_descend: its trial steps; _search adds the starts')
+    warnings: int = 0  # EMD solves that did not end optimal
 
     @property
     def center(self) -> np.ndarray:
@@ -147,7 +147,6 @@ class IemdTracker:
         self._center = None
         self._size = None
         self._angle = 0.0  # orientation of the tracked window (radians), only ever changed by priors
-        self._search_angle = 0.0  # orientation of the windows searched in the current frame
         self._background_emd = np.inf
         self._frame_index = 0
         self._lost = False
@@ -160,7 +159,7 @@ class IemdTracker:
         cfg = self.config
         self._center = box_centre((x, y, w, h))
         self._size = np.array([w, h], dtype=np.float64)
-        self._angle = self._search_angle = 0.0
+        self._angle = 0.0
         pyramid = ImagePyramid(to_gray(frame))
         template = pyramid.sample(self._center, self._size, cfg.template_size)
         self.dictionary = TemplateDictionary(self.layout, cfg.n_templates, cfg.lam,
@@ -187,25 +186,24 @@ class IemdTracker:
             center, size, turn = _apply_prior(_check_prior(prior), center, size)
             angle = _wrap_angle(angle + turn)
         self._frame_index += 1
-        self._search_angle = angle
         predicted = _box(center, size, angle)
         pyramid = ImagePyramid(to_gray(frame))
 
-        best = self._search(pyramid, center, size)
+        best = self._search(pyramid, center[None], size, angle)
         searches = [best]
         starts, codings = 1, best.codings
         baseline = self._background_emd
         if cfg.n_particles and (self._lost or best.emd > cfg.particle_trigger * baseline):
             # Section 6.1: more starting points around the prediction for abrupt motion.
             distance = cfg.particle_offset * (2.0 if self._lost else 1.0)
-            candidate = self._particle_search(pyramid, center + _particle_offsets(cfg.n_particles, distance) * size,
-                                              size)
+            candidate = self._search(pyramid, center + _particle_offsets(cfg.n_particles, distance) * size, size,
+                                     angle)
             starts, codings = starts + cfg.n_particles, codings + candidate.codings
             searches.append(candidate)
             if candidate.emd < best.emd:
                 best = candidate
-        final, scale, emd, scale_codings, scale_warnings = self._search_scale(best, size)
-        new_center, new_size = final.center, final.size
+        final, scale = self._search_scale(best)
+        emd, new_center, new_size = final.emd, final.center, final.model.size
         best_box = _box(new_center, new_size, angle)
         visible = _visible_fraction(new_center, new_size, angle, frame.shape)
         reason = ""
@@ -219,11 +217,11 @@ class IemdTracker:
         if not lost:
             self._center, self._size, self._angle = new_center, new_size, angle
             if cfg.update_templates:
-                if self.dictionary.observe(final.template, emd, self._frame_index):
+                if self.dictionary.observe(final.model.template, emd, self._frame_index):
                     self._refresh_target()
         return TrackResult(
             box=best_box, emd=emd, iterations=best.iterations, lost=lost, scale=scale, angle=angle, starts=starts,
-            codings=codings + scale_codings, solver_warnings=sum(s.warnings for s in searches) + scale_warnings,
+            codings=codings + final.codings, solver_warnings=sum(s.warnings for s in searches) + final.warnings,
             predicted_box=predicted, reason=reason,
         )
 
@@ -256,57 +254,30 @@ class IemdTracker:
         self._target = TargetModel.from_patches(self.layout.positions(), self._target_eps, pooled,
                                                 self.config.kernel_bandwidth)
 
-    def _candidate(self, pyramid: ImagePyramid, center, size, coarse: bool = False) -> CandidateModel:
-        """The candidate model at a window, against the full target (or the coarse stage's)."""
+    def _candidate(self, pyramid: ImagePyramid, center, size, coarse: bool = False, angle: float = 0.0
+                   ) -> CandidateModel:
+        """The candidate model at a window turned by ``angle``, against the full target (or the coarse stage's)."""
         cfg = self.config
         if coarse:
             return CandidateModel(pyramid, self.layout, center, size, self._coarse_target, None, cfg.alpha,
-                                  cfg.kernel_bandwidth, coarse=1, angle=self._search_angle)
+                                  cfg.kernel_bandwidth, coarse=1, angle=angle)
         return CandidateModel(pyramid, self.layout, center, size, self._target, self.dictionary, cfg.alpha,
-                              cfg.kernel_bandwidth, angle=self._search_angle)
+                              cfg.kernel_bandwidth, angle=angle)
 
-    def _search(self, pyramid: ImagePyramid, center, size) -> _Descent:
-        """Coarse-to-fine Algorithm 1 from one starting point.
+    def _search(self, pyramid: ImagePyramid, starts: np.ndarray, size, angle: float) -> _Descent:
+        """Coarse-to-fine Algorithm 1 from one or more starts (N, 2); only the best-scored start is refined.
 
         The appearance EMD is minimal at the target, but its basin is only about
         as wide as the patches' texture is coarse (a few pixels for fine texture).
-        With ``coarse_to_fine`` a first descent runs on templates sampled one
+        With ``coarse_to_fine`` each start first descends on templates sampled one
         pyramid level smoother, with kernel-only weights (no sparse coding, so it
-        is cheap), and the full model refines from where it ends.  Measured
-        (benchmarks/tune_tracker.py, Car4/Bolt2/Woman average overlap, with the
-        defaults of the time): on 36.2 %, off 34.9 % (it helps the panning Bolt2 and Woman, hurts the large Car4).
-        """
-        return self._particle_search(pyramid, np.atleast_2d(np.asarray(center, dtype=np.float64)), size)
-
-    def _particle_search(self, pyramid: ImagePyramid, starts: np.ndarray, size) -> _Descent:
-        """Section 6.1's extra starting points, refined only where they look best.
-
-        Each start descends on the coarse level only (no sparse coding) and is
-        scored by the full model where it ends; only the best one gets the fine
-        descent.  Running the whole coarse-to-fine search from every start gave
-        p95 update times of 80-100 ms (5x a normal frame).
-        """
-        scored, warnings = [], 0
-        for start in starts:
-            if self.config.coarse_to_fine:
-                coarse = self._descend(self._candidate(pyramid, start, size, coarse=True))
-                start, warnings = coarse.center, warnings + coarse.warnings
-            model = self._candidate(pyramid, start, size)
-            scored.append((model.emd()[0], model))
-        winner = min(scored, key=lambda item: item[0])[1]
-        best = self._descend(winner)  # counts the winner's solve (cached from the scoring)
-        best.codings += len(scored)
-        best.warnings += warnings + sum(_not_optimal(m.emd()[1]) for _, m in scored if m is not winner)
-        return best
-
-    def _descend(self, model: CandidateModel) -> _Descent:
-        """Algorithm 1 from the window of ``model``: move against dEMD/dy while the EMD decreases.
-
-        The paper moves one pixel along the gradient and stops at the first EMD
-        increase.  We start with ``step_px`` and halve the step on an increase,
-        stopping below ``min_step_px``: the same stopping rule (the EMD no longer
-        decreases, at the finest step), but it reaches sub-pixel positions and
-        covers larger motions in fewer EMD solves.
+        is cheap); the full model scores where each ends, and only the best one
+        gets the fine descent.  Measured (benchmarks/tune_tracker.py,
+        Car4/Bolt2/Woman average overlap, with the defaults of the time): on
+        36.2 %, off 34.9 % (it helps the panning Bolt2 and Woman, hurts the large
+        Car4).  With section 6.1's extra starting points, running the whole
+        coarse-to-fine search from every start gave p95 update times of
+        80-100 ms (5x a normal frame).
 
         Capture range (benchmarks/model_ceiling.py --capture, exact model, 12 OTB
         sequences): starts 0.05 / 0.1 / 0.2 / 0.4 window sizes off end on the
@@ -317,13 +288,35 @@ class IemdTracker:
         gain (12-sequence average overlap 31.3 vs 31.9 %: a wider basin also
         reaches distractors) and updates took 3x longer, so it was not kept.
         """
+        scored, warnings = [], 0
+        for start in starts:
+            if self.config.coarse_to_fine:
+                coarse = self._descend(self._candidate(pyramid, start, size, coarse=True, angle=angle))
+                start, warnings = coarse.center, warnings + coarse.warnings
+            model = self._candidate(pyramid, start, size, angle=angle)
+            scored.append((*model.emd(), model))
+        winner = min(scored, key=lambda item: item[0])[2]
+        best = self._descend(winner)  # counts the winner's solve (cached from the scoring)
+        best.codings += len(scored)
+        best.warnings += warnings + sum(_not_optimal(sol) for _, sol, m in scored if m is not winner)
+        return best
+
+    def _descend(self, model: CandidateModel) -> _Descent:
+        """Algorithm 1 from the window of ``model``: move against dEMD/dy while the EMD decreases.
+
+        The paper moves one pixel along the gradient and stops at the first EMD
+        increase.  We start with ``step_px`` and halve the step on an increase,
+        stopping below ``min_step_px``: the same stopping rule (the EMD no longer
+        decreases, at the finest step), but it reaches sub-pixel positions and
+        covers larger motions in fewer EMD solves.
+        """
         cfg = self.config
         half = model.size / 2.0
         axes = window_axes(model.angle)
         emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
         state = _Descent(model=model, emd=emd, warnings=_not_optimal(sol))
-        # The coarse stage samples one pyramid level up: its steps are twice as long.
-        level_scale = 2.0 if model.coarse else 1.0
+        # A coarse stage samples ``coarse`` pyramid levels up: its steps are that much longer.
+        level_scale = 2.0 ** model.coarse
         step, min_step = cfg.step_px * level_scale, cfg.min_step_px * level_scale
         while state.iterations < cfg.n_iter and step >= min_step:
             g_px = axes @ (grad / half)  # gradient with respect to image pixels
@@ -341,7 +334,7 @@ class IemdTracker:
                 step *= 0.5
         return state
 
-    def _search_scale(self, state: _Descent, size):
+    def _search_scale(self, state: _Descent) -> tuple[_Descent, float]:
         """Scale variants at the converged centre (paper: window enlarged/shrunk by 2%).
 
         Each variant is a candidate model of the window resampled at s * size, so it
@@ -351,25 +344,26 @@ class IemdTracker:
         measured as runaway growth on Car4.)  In each direction the search keeps
         stepping by ``scale_step`` while the EMD decreases, up to ``scale_range``
         (the paper's gyro experiment searches +-10 %: a camera closing in on the
-        target grows it faster than 2 % per frame).  Returns (the chosen window's model, scale, emd,
-        models built, solver warnings).
+        target grows it faster than 2 % per frame).  Returns the chosen window (its
+        ``codings`` and ``warnings`` those of the variants) and its relative scale.
         """
         cfg = self.config
-        best, best_scale, best_emd, codings, warnings = state.model, 1.0, state.emd, 0, 0
+        chosen = _Descent(model=state.model, emd=state.emd)
+        best_scale = 1.0
         if cfg.scale_step == 0:
-            return best, best_scale, best_emd, codings, warnings
+            return chosen, best_scale
         n_steps = int(np.floor(cfg.scale_range / cfg.scale_step + 1e-9))
         for direction in (-1.0, 1.0):
             for n in range(1, n_steps + 1):
                 scale = 1.0 + direction * n * cfg.scale_step
-                model = state.model.at(state.center, size * scale)
+                model = state.model.at(state.center, state.model.size * scale)
                 emd, sol = model.emd()
-                codings += 1
-                warnings += _not_optimal(sol)
-                if emd >= best_emd:
+                chosen.codings += 1
+                chosen.warnings += _not_optimal(sol)
+                if emd >= chosen.emd:
                     break
-                best, best_scale, best_emd = model, scale, emd
-        return best, best_scale, best_emd, codings, warnings
+                chosen.model, chosen.emd, best_scale = model, emd, scale
+        return chosen, best_scale
 
 
 def compile_jit() -> None:
