@@ -76,7 +76,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     from sensor_msgs.msg import CameraInfo, Image, Imu
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.conversions import array_to_image_fields, ns_to_stamp, stamp_ns
+    from iemd_ros.conversions import fill_image_msg, ns_to_stamp, stamp_ns
 
     env = dict(os.environ)             # the caller set FASTRTPS_DEFAULT_PROFILES_FILE for -shm
     box0 = [float(v) for v in seq.gt_boxes[0]]
@@ -148,13 +148,9 @@ def _run(args, seq, setup: str, subject: str) -> dict:
         info.distortion_model = "plumb_bob"
         msgs = []
         for k, frame in enumerate(seq.frames):
-            m = Image()
+            m = fill_image_msg(Image(), frame)
             m.header.frame_id = "cam"
             m.header.stamp.sec, m.header.stamp.nanosec = ns_to_stamp(int(seq.frame_stamps_ns[k]))
-            f = array_to_image_fields(frame)
-            m.encoding, m.height, m.width, m.step, m.is_bigendian = (f["encoding"], f["height"], f["width"],
-                                                                     f["step"], f["is_bigendian"])
-            m.data = f["data"]
             msgs.append(m)
         gi = 0
         t0 = time.monotonic()

@@ -433,7 +433,7 @@ class TrackerNode(Node):
         if self._debug_pub.get_subscription_count() == 0 or self._stop:
             return
         canvas = draw_result(frame, result)
-        out = fill_image_msg(Image(), canvas)   # data as bytes: ~0.06 ms, a numpy array ~68 ms per VGA frame
+        out = fill_image_msg(Image(), canvas)
         out.header = img.header
         if self.context.ok():
             self._debug_pub.publish(out)
