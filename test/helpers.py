@@ -69,11 +69,11 @@ def run_module(module: str, *args: str, timeout: float = 120, **kw) -> subproces
                           env={**os.environ, "PYTHONPATH": str(REPO)}, **kw)
 
 
-def csv_rows(path) -> list[list[str]]:
+def read_csv_rows(path) -> list[list[str]]:
     with open(path, newline="") as f:
         return list(csv.reader(f))
 
 
 def csv_boxes(path) -> np.ndarray:
     """The boxes (columns 1-4, x y w h) of an iemd-replay CSV, one row per image below the header."""
-    return np.array([[float(v) for v in r[1:5]] for r in csv_rows(path)[1:]])
+    return np.array([[float(v) for v in r[1:5]] for r in read_csv_rows(path)[1:]])

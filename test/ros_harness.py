@@ -37,10 +37,13 @@ def imu_msg(t_ns: int, w) -> Imu:
     return msg
 
 
+_ISOLATION_KEYS = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")
+
+
 @contextmanager
 def isolated_ros_env():
     """A random ROS_DOMAIN_ID in 30..99 and localhost-only discovery (restored afterwards)."""
-    saved = {k: os.environ.get(k) for k in ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE")}
+    saved = {k: os.environ.get(k) for k in _ISOLATION_KEYS}
     domain = random.SystemRandom().randint(30, 99)
     os.environ["ROS_DOMAIN_ID"] = str(domain)
     os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
@@ -52,6 +55,12 @@ def isolated_ros_env():
                 os.environ.pop(k, None)
             else:
                 os.environ[k] = v
+
+
+def child_env(base) -> dict:
+    """``base`` with the domain and discovery range of the enclosing isolated_ros_env / ros_context,
+    for a child process that must meet the test's nodes."""
+    return {**base, **{k: os.environ[k] for k in _ISOLATION_KEYS}}
 
 
 @contextmanager

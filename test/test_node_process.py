@@ -13,7 +13,7 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 from ament_index_python.packages import PackageNotFoundError, get_package_prefix  # noqa: E402
 from helpers import bbox_values  # noqa: E402
-from ros_harness import Driver, isolated_ros_env, ros_context, spinning  # noqa: E402
+from ros_harness import Driver, child_env, isolated_ros_env, ros_context, spinning  # noqa: E402
 
 from iemd_ros.conversions import stamp_ns  # noqa: E402
 from iemd_ros.synthetic import generate  # noqa: E402
@@ -61,8 +61,7 @@ def test_invalid_parameter_exits_2_with_one_line(executable):
     exe, params, env = executable
     with isolated_ros_env():
         proc = subprocess.run([str(exe), "--ros-args", "--params-file", str(params), "-p", "tracker.step_px:=0.1"],
-                              env={**env, **{k: os.environ[k] for k in ("ROS_DOMAIN_ID",
-                                                                        "ROS_AUTOMATIC_DISCOVERY_RANGE")}},
+                              env=child_env(env),
                               capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2, proc.stderr
     assert "Traceback" not in proc.stderr
@@ -75,7 +74,7 @@ def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable, st
     s = [int(v) for v in seq.frame_stamps_ns]
     box0 = ",".join(f"{v:.3f}" for v in seq.gt_boxes[0])
     with ros_context() as context:                 # isolated domain, localhost-only discovery
-        env = {**env, "ROS_DOMAIN_ID": str(context.get_domain_id()), "ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST"}
+        env = child_env(env)
         proc = _start(exe, ["--ros-args", "--params-file", str(params), "-r", "image:=/cam/image_raw",
                             "-p", f"initial_box:=[{box0}]", "-p", "diagnostics_period_s:=0.2",
                             "-p", "imu_wait_ms:=200.0"], env)

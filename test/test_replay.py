@@ -9,11 +9,11 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from bag_fixtures import by_topic, make_bag, read_all, shaky_sequence, stamps
-from helpers import REPO, cli_error, csv_boxes, csv_rows, detection_box, run_module
+from bag_fixtures import IMG, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
+from helpers import REPO, cli_error, csv_boxes, detection_box, read_csv_rows, run_module
 
 from iemd_ros.bag_io import BagWriter
-from iemd_ros.bag_make import (DEFAULT_TOPICS, _camera_info_msg, _image_msg, _imu_msg, source_from_folder, write_bag,
+from iemd_ros.bag_make import (_camera_info_msg, _image_msg, _imu_msg, source_from_folder, write_bag,
                                  write_gt)
 from iemd_ros.cli import split_ros_args
 from iemd_ros.metrics import iou, score_sequence
@@ -47,7 +47,7 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     assert main(argv + ["--csv", str(tmp_path / "b.csv")]) == 0
     a, b = (tmp_path / "a.csv").read_bytes(), (tmp_path / "b.csv").read_bytes()
     assert a == b                                              # same bag twice -> identical CSV
-    rows = csv_rows(tmp_path / "a.csv")
+    rows = read_csv_rows(tmp_path / "a.csv")
     assert tuple(rows[0]) == CSV_HEADER and len(rows) == N + 1   # one row per image
     assert [int(r[0]) for r in rows[1:]] == seq.frame_stamps_ns.tolist()
     assert rows[1][6] == "init" and rows[1][5] == "" and [float(v) for v in rows[1][1:5]] == seq.gt_boxes[0].tolist()
@@ -64,7 +64,7 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     dets, diags = by_topic(out, DETECTIONS_TOPIC), by_topic(out, DIAGNOSTICS_TOPIC)
     assert len(dets) == len(diags) == N
     np.testing.assert_array_equal(stamps(dets), seq.frame_stamps_ns)
-    img_log = [t for topic, _, t, _ in inp if topic == DEFAULT_TOPICS["image"]]
+    img_log = [t for topic, _, t, _ in inp if topic == IMG]
     assert [t for topic, _, t, _ in out if topic == DETECTIONS_TOPIC] == img_log
     for k, (d, r) in enumerate(zip(dets, rows[1:])):
         if r[6] in ("tracking", "init"):
@@ -111,7 +111,7 @@ def test_ros1_converted_matches_ros2_desk(imu_root, tmp_path):
                           "--dst-typestore", "ros2_jazzy"], capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stderr
     conv_msgs = read_all(tmp_path / "desk_conv")
-    info = by_topic(conv_msgs, DEFAULT_TOPICS["camera_info"])[0]
+    info = by_topic(conv_msgs, INFO)[0]
     assert hasattr(info, "k") and not hasattr(info, "K")        # ROS 2 field names after conversion
     init = _init(src)
     csvs = {}
@@ -120,7 +120,7 @@ def test_ros1_converted_matches_ros2_desk(imu_root, tmp_path):
         assert main([str(tmp_path / name), "--init", init, "--csv", str(csvs[name])]) == 0
     ref = csvs["desk_ros2"].read_bytes()
     assert csvs["desk_conv"].read_bytes() == ref and csvs["desk.bag"].read_bytes() == ref
-    assert len(csv_rows(csvs["desk_ros2"])) == 9
+    assert len(read_csv_rows(csvs["desk_ros2"])) == 9
 
 
 def _bag_with(path, *, image_topics=("/cam/image",), imu=False, info=False, bad_step_at=None, n=4, seq=None):
@@ -145,7 +145,7 @@ def test_no_imu_warns_and_tracks_without_gyro(seq, tmp_path, capsys):
     assert main([str(tmp_path / "noimu"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 0
     err = capsys.readouterr().err
     assert "warning" in err and "no sensor_msgs/msg/Imu topic" in err and "without the gyro prior" in err
-    assert len(csv_rows(tmp_path / "o.csv")) == 5
+    assert len(read_csv_rows(tmp_path / "o.csv")) == 5
     # IMU but no camera info: also a warning, no prior
     res = replay(tmp_path / "noimu", seq.gt_boxes[0], warn=lambda s: None)
     assert res.gyro_used == 0 and res.warnings
@@ -157,7 +157,7 @@ def test_topic_selection_and_malformed_image(seq, tmp_path, capsys):
     assert "2 sensor_msgs/msg/Image topics" in err and "--image-topic" in err
     assert main([str(tmp_path / "two"), "--init", _init(seq), "--image-topic", "/b/image",
                  "--csv", str(tmp_path / "o.csv")]) == 0
-    rows = csv_rows(tmp_path / "o.csv")
+    rows = read_csv_rows(tmp_path / "o.csv")
     assert [r[6] for r in rows[1:]][2] == "malformed" and rows[3][1] == ""   # the bad image: a row, no box
     assert rows[4][6] in ("tracking", "lost")                                 # and tracking goes on
 
@@ -184,8 +184,8 @@ def test_bad_input(seq, bags, tmp_path, capsys):
         ([str(tmp_path / "r.bag"), "--init", init], "truncated or corrupt"),
         ([str(tmp_path / "not_a_bag"), "--init", init], "no metadata.yaml"),
         ([str(tmp_path / "imu_only"), "--init", init], "has no sensor_msgs/msg/Image topic"),
-        ([str(bags / "shaky"), "--init", init, "--image-topic", DEFAULT_TOPICS["imu"]], "expected sensor_msgs/msg/Image"),
-        ([str(bags / "shaky"), "--init", init, "--imu-topic", DEFAULT_TOPICS["image"]], "expected sensor_msgs/msg/Imu"),
+        ([str(bags / "shaky"), "--init", init, "--image-topic", IMU], "expected sensor_msgs/msg/Image"),
+        ([str(bags / "shaky"), "--init", init, "--imu-topic", IMG], "expected sensor_msgs/msg/Imu"),
         ([str(bags / "shaky"), "--init", init, "--camera-info-topic", "/nope"], "is not in the bag"),
         ([str(bags / "shaky"), "--init", "400,10,20,20"], "outside the 320x240 image"),
         ([str(bags / "shaky"), "--init", "10,10,0,20"], "positive size"),

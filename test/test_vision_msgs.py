@@ -219,8 +219,10 @@ def _publisher_main(topic: str) -> int:
     return 0
 
 
-def _child_env(domain_id: int) -> dict:
-    env = dict(os.environ, ROS_DOMAIN_ID=str(domain_id), ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST")
+def _child_env() -> dict:
+    from ros_harness import child_env
+
+    env = child_env(os.environ)
     if importlib.util.find_spec("ros_wheels_bootstrapper") is not None:
         # pip-only venv: the child must work with no ROS environment variables at all.
         for name in ("LD_LIBRARY_PATH", "AMENT_PREFIX_PATH", "_ROS_WHEELS_BOOTSTRAP_COMPLETE"):
@@ -237,7 +239,7 @@ def test_detection2d_array_between_processes(vm, stop_process):
     with ros_context() as context:                  # isolated domain, localhost-only discovery
         publisher = subprocess.Popen(
             [sys.executable, str(Path(__file__).resolve()), "--publish", topic],
-            env=_child_env(context.get_domain_id()), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+            env=_child_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
             node = rclpy.create_node("vision_msgs_test_subscriber", context=context)
             received = []
