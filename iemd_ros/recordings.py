@@ -184,8 +184,9 @@ def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True
     cfg = PipelineConfig(tracker=config if config is not None else TrackerConfig(), gyro=rec.gyro_config(),
                          use_gyro=use_gyro)
     pipe = TrackingPipeline(cfg, camera=rec.camera)
-    for t, w in zip(rec.imu_t_ns, rec.gyro):
-        pipe.add_imu(int(t), w)
+    if use_gyro:                                   # as the node gets them: one message at a time
+        for t, w in zip(rec.imu_t_ns, rec.gyro):
+            pipe.add_imu(int(t), w)
     pipe.init(rec.load_frame(start), rec.gt_boxes[start], int(rec.frame_stamps_ns[start]))
     results, no_prior = [], []
     for k in range(start + 1, stop):
