@@ -1,9 +1,10 @@
 """Per-message cost of the IMU path, this checkout against a baseline revision, in the same run.
 
 The baseline's ``iemd_ros`` is taken from git (``git archive REV iemd_ros``) into a temporary folder
-and imported under another name (its numba kernels compile there once: a few seconds), so both
-versions run in one process on the same inputs.  The calls are timed alternately (old, new, old, ...;
-the best of ``--repeats`` rounds each), so load changes on a shared machine hit both alike.  Timed:
+and imported under another name (its numba kernels, the tracker's included, compile there on every
+run: about 10 s before any timing), so both versions run in one process on the same inputs.  The
+calls are timed alternately (old, new, old, ...; the best of ``--repeats`` rounds each), so load
+changes on a shared machine hit both alike.  Timed:
 
 * ``ImuBuffer.add`` of one sample (int stamp, rate triple: one sensor_msgs/Imu), 200 Hz stamps;
 * ``TrackingPipeline.add_imu`` of one sample (what the node and the replay call per Imu message);

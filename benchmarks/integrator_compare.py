@@ -19,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 
-from iemd_ros.imu import ImuBuffer
 from iemd_ros.rotation import integrate_first_order, integrate_rates, quat_to_rot, rotation_angle, so3_exp
 from iemd_ros.synthetic import SyntheticConfig, angular_velocity
 
@@ -84,9 +83,7 @@ def desk(root: Path) -> None:
     from iemd_ros.recordings import load_recording
 
     rec = load_recording(root / "cmu_hwangbo_desk")
-    buf = ImuBuffer(max_duration_ns=10 ** 13, max_samples=10 ** 7)    # sorted, repeats merged
-    buf.add(rec.imu_t_ns, rec.gyro)
-    t, w = buf.samples()
+    t, w = rec.gyro_predictor().buffer.samples()    # the whole record, sorted, repeats merged
     t_s = (t - t[0]) * 1e-9
     tf = (rec.frame_imu_ns - t[0]) * 1e-9
     pairs = [both(t_s, w, a, b) for a, b in zip(tf[:-1], tf[1:])]

@@ -34,7 +34,7 @@ import numpy as np
 
 from .boxes import centre_box, check_box
 from .camera import CameraModel
-from .imu import _ACCEPTED, Coverage, ImuBuffer, ImuIntegration
+from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
 from .rotation import GyroCalibration, StillBiasEstimator
 
 __all__ = ["rotation_homography", "warp_points", "box_grid", "local_prior", "predict_box",
@@ -228,8 +228,9 @@ class GyroPredictor:
     new frame yet, the result has ``status == not_covered`` and no prior: wait a bounded time
     (:meth:`ready`) and call again, or go on without the prior and log ``reason``.  ``camera`` may be
     None until the calibration is known (set it then): samples are buffered, :meth:`predict` needs it.
-    ``config`` is not checked again here: :class:`GyroConfig` checks its fields when it is built
-    (``__post_init__``); it is a mutable dataclass, so fields changed afterwards go unchecked.
+    ``config`` is checked by :class:`GyroConfig` when it is built, and the parts built from it here
+    (calibration, IMU buffer, bias estimator) check their own values again, so a field changed
+    afterwards is still caught.
     """
 
     def __init__(self, camera: CameraModel | None, config: GyroConfig | None = None):
@@ -251,7 +252,7 @@ class GyroPredictor:
         :class:`~iemd_ros.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
         status = self.buffer.add(t_ns, w)
         if not self.bias_estimator.done:
-            good = status == _ACCEPTED
+            good = status == SampleStatus.ACCEPTED
             if good.any() and self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
         return status
@@ -293,9 +294,10 @@ class GyroPredictor:
 
 def compile_gyro_jit() -> None:
     """JIT-compile the gyro path's numba kernels now (or load them from numba's on-disk cache):
-    the window integration and the lens undistortion.  In a fresh environment the first gyro
-    prediction otherwise stalls for ~2 s; :class:`iemd_ros.pipeline.TrackingPipeline` (node and
-    replay) calls this, with :func:`iemd_ros.tracker.compile_jit`, once per process at start-up."""
+    the IMU screening, the window integration and the lens model.  In a fresh environment the first
+    IMU message and gyro prediction otherwise stall for seconds (4.5 s measured on a cold cache);
+    :class:`iemd_ros.pipeline.TrackingPipeline` (node and replay) calls this, with
+    :func:`iemd_ros.tracker.compile_jit`, once per process at start-up."""
     predictor = GyroPredictor(CameraModel(np.diag([100.0, 100.0, 1.0]), [0.1, 0.0, 0.0, 0.0, 0.0], 64, 48))
     predictor.add_imu(np.array([0, 10_000_000, 20_000_000]), np.full((3, 3), 0.1))
     predictor.predict(2_000_000, 12_000_000, (16.0, 16.0, 16.0, 16.0))
