@@ -29,7 +29,7 @@ from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
-from iemd_ros.evaluation import collect_sequences
+from iemd_ros.evaluation import sequence_names
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
 OFFSETS = np.linspace(-0.6, 0.6, 13)
@@ -107,7 +107,7 @@ def main():
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--capture", action="store_true", help="also measure the descent's capture range")
     args = parser.parse_args()
-    names = [seq.name for seq in collect_sequences([], args.sequences.split(",") if args.sequences else None)]
+    names = sequence_names(args.sequences)
     jobs = [(name, args.stride, args.jump) for name in names]
     with Pool(args.jobs) as pool:
         results = pool.map(measure, jobs)

@@ -21,7 +21,7 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import TrackerConfig
-from iemd_ros.evaluation import IemdAdapter, collect_sequences, make_tracker, run_tracker
+from iemd_ros.evaluation import IemdAdapter, make_tracker, run_tracker, sequence_names
 from iemd_ros.metrics import score_sequence
 from iemd_ros.otb import default_root, load_sequence
 
@@ -55,7 +55,7 @@ def main() -> None:
     parser.add_argument("--shift", type=float, default=0.1, help="start shift, fraction of the box size")
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
-    names = [seq.name for seq in collect_sequences([], args.sequences.split(",") if args.sequences else None)]
+    names = sequence_names(args.sequences)
     # Checked here, before any run: a bad key or peer fails at once with its own message.
     runs = [(f"iemd {c}" if args.config else "iemd", TrackerConfig.from_dict(ast.literal_eval(c)))
             for c in (args.config or ["{}"])]

@@ -37,7 +37,7 @@ from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.emd import ground_distance, solve_emd
 from iemd_ros.histogram import candidate_weights
-from iemd_ros.evaluation import collect_sequences
+from iemd_ros.evaluation import sequence_names
 from iemd_ros.otb import default_root, load_sequence, read_frame
 from model_ceiling import grid_argmin  # benchmarks/ is the script's directory
 
@@ -112,7 +112,7 @@ def main():
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     with Pool(args.jobs) as pool:
-        names = [seq.name for seq in collect_sequences([], args.sequences.split(",") if args.sequences else None)]
+        names = sequence_names(args.sequences)
         results = pool.map(measure, [(n, args.frames, args.stride) for n in names])
     print(f"{'sequence':14s} {'votes f1 %':>10s} {'votes k %':>10s} {'argmin (a)':>11s} {'argmin (b)':>11s}"
           "   (argmin: mean distance from the truth, window sizes)")

@@ -283,6 +283,12 @@ def collect_sequences(inputs: list[str], wanted: list[str] | None) -> list[Seque
     return [load_sequence(name, found[name]) for name in selected]
 
 
+def sequence_names(wanted: str | None) -> list[str]:
+    """Names of the targets in ``../shared/data/otb`` chosen by a comma-separated list (as
+    :func:`collect_sequences`; empty or None: all), for scripts whose workers load them by name."""
+    return [seq.name for seq in collect_sequences([], wanted.split(",") if wanted else None)]
+
+
 def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print) -> dict:
     """Run every tracker on every sequence, write ``results.json`` and success plots into ``out``."""
     out.mkdir(parents=True, exist_ok=True)

@@ -8,7 +8,7 @@ import pytest
 from helpers import PNG_SIGNATURE, run_module
 
 from iemd_ros import evaluation
-from iemd_ros.evaluation import main, make_tracker, run_tracker
+from iemd_ros.evaluation import main, make_tracker, run_tracker, sequence_names
 from iemd_ros.otb import load_sequence
 
 # Measured on Car4 frames 1-20 (OpenCV 5.0.0 contrib): CSRT average overlap 85.8 %, KCF 87.9 %.
@@ -136,3 +136,11 @@ def test_bad_argument_subprocess_no_traceback(tmp_path):
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert "holds no OTB sequence" in proc.stderr
+
+
+def test_sequence_names_selects_from_the_shared_otb_root(otb_root):
+    assert sequence_names("jogging,Car4") == ["Jogging-1", "Jogging-2", "Car4"]
+    everything = sequence_names(None)
+    assert sequence_names("") == everything and {"Car4", "Woman", "Jogging-1"} <= set(everything)
+    with pytest.raises(ValueError, match="unknown sequence 'Nope'"):
+        sequence_names("Nope")
