@@ -25,6 +25,7 @@ from .boxes import box_centre, centre_box, check_box
 
 __all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
            "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
+           "bbox_values", "fill_bbox",
            "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
 
 # encoding -> (channels, bytes per channel)
@@ -193,6 +194,19 @@ def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) 
     """
     cx, cy, sx, sy = check_box((center_x, center_y, size_x, size_y), "bounding box (center_x, center_y, size_x, size_y)")
     return tuple(float(v) for v in centre_box((cx, cy), (sx, sy)))
+
+
+def bbox_values(bbox) -> tuple[float, float, float, float]:
+    """A ``vision_msgs/BoundingBox2D`` (rclpy or rosbags message) -> ``(center_x, center_y, size_x, size_y)``."""
+    c = bbox.center.position
+    return c.x, c.y, bbox.size_x, bbox.size_y
+
+
+def fill_bbox(bbox, values) -> None:
+    """Set a ``vision_msgs/BoundingBox2D``'s centre and size from ``(center_x, center_y, size_x, size_y)``
+    (:func:`box_to_bbox`'s values); ``theta`` is left as it is."""
+    c = bbox.center.position
+    c.x, c.y, bbox.size_x, bbox.size_y = (float(v) for v in values)
 
 
 CLASS_ID = "target"  # default class_id of the published hypothesis (node parameter ``class_id``)

@@ -42,8 +42,8 @@ from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithP
 
 from .boxes import check_box
 from .cli import one_line
-from .conversions import (CLASS_ID, DETECTION_ID, bbox_to_box, camera_model_from_msg, fill_image_msg,
-                          detection_values, image_from_msg, imu_sample, stamp_ns)
+from .conversions import (CLASS_ID, DETECTION_ID, bbox_to_box, bbox_values, camera_model_from_msg, detection_values,
+                          fill_bbox, fill_image_msg, image_from_msg, imu_sample, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
 from .pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
@@ -289,9 +289,8 @@ class TrackerNode(Node):
             self.get_logger().info(f"camera model: {camera!r}")
 
     def _on_init(self, msg: Detection2D) -> None:
-        c = msg.bbox.center.position
         try:
-            box = bbox_to_box(c.x, c.y, msg.bbox.size_x, msg.bbox.size_y)
+            box = bbox_to_box(*bbox_values(msg.bbox))
         except ValueError as exc:
             self._note = f"~/init rejected: {exc}"
             self._warn(self._note)
@@ -416,8 +415,7 @@ class TrackerNode(Node):
             det = Detection2D()
             det.header = img.header
             det.id = self._detection_id
-            c = det.bbox.center.position
-            c.x, c.y, det.bbox.size_x, det.bbox.size_y = values.bbox
+            fill_bbox(det.bbox, values.bbox)
             hyp = ObjectHypothesisWithPose()
             hyp.hypothesis.class_id = self._class_id
             hyp.hypothesis.score = values.score

@@ -14,7 +14,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.conversions import bbox_to_box
+from iemd_ros.conversions import bbox_to_box, bbox_values
 
 REPO = Path(__file__).resolve().parents[1]
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -40,12 +40,6 @@ def shifted(img, dx, dy, interpolation=cv2.INTER_CUBIC):
     """``img`` translated by (dx, dy) px, borders reflected."""
     m = np.float32([[1, 0, dx], [0, 1, dy]])
     return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=interpolation, borderMode=cv2.BORDER_REFLECT)
-
-
-def bbox_values(bbox) -> tuple[float, float, float, float]:
-    """A ``vision_msgs/BoundingBox2D`` (rclpy or rosbags message) -> ``(center x, center y, size_x, size_y)``."""
-    c = bbox.center.position
-    return c.x, c.y, bbox.size_x, bbox.size_y
 
 
 def detection_box(detection) -> tuple[float, float, float, float]:

@@ -18,7 +18,7 @@ from sensor_msgs.msg import CameraInfo, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray
 
-from iemd_ros.conversions import box_to_bbox, fill_image_msg, ns_to_stamp
+from iemd_ros.conversions import box_to_bbox, fill_bbox, fill_image_msg, ns_to_stamp
 
 FRAME_ID = "synthetic_cam"
 
@@ -159,8 +159,7 @@ class Driver:
     def publish_init(self, box, t_ns: int) -> None:
         msg = Detection2D()
         stamp_header(msg.header, t_ns)
-        c = msg.bbox.center.position
-        c.x, c.y, msg.bbox.size_x, msg.bbox.size_y = box_to_bbox(box)
+        fill_bbox(msg.bbox, box_to_bbox(box))
         self.init_pub.publish(msg)
 
     # ---------------------------------------------------------------- services

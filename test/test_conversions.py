@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from iemd_ros.boxes import box_centre, centre_box, check_box
-from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, box_to_bbox, camera_model_from_info,
-                                  detection_values, fill_image_msg, image_from_msg, image_to_array, imu_sample,
-                                  ns_to_stamp, stamp_to_ns)
+from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, bbox_values, box_to_bbox,
+                                  camera_model_from_info, detection_values, fill_bbox, fill_image_msg,
+                                  image_from_msg, image_to_array, imu_sample, ns_to_stamp, stamp_to_ns)
 from iemd_ros.pipeline import FrameResult
 
 
@@ -118,6 +118,16 @@ def test_box_bbox_round_trip():
         bbox_to_box(1, 2, 0, 5)
     with pytest.raises(ValueError, match="finite"):
         bbox_to_box(float("nan"), 1, 3, 5)
+
+
+def test_bbox_message_fields_round_trip():
+    BoundingBox2D = pytest.importorskip("vision_msgs.msg").BoundingBox2D
+    bbox = BoundingBox2D()
+    bbox.center.theta = 0.25
+    fill_bbox(bbox, box_to_bbox((10, 20, 4, 6)))
+    assert (bbox.center.position.x, bbox.center.position.y, bbox.size_x, bbox.size_y) == (11.5, 22.5, 4.0, 6.0)
+    assert bbox.center.theta == 0.25  # the orientation is not the box's to set
+    assert bbox_to_box(*bbox_values(bbox)) == (10.0, 20.0, 4.0, 6.0)
 
 
 def test_detection_values_only_while_tracking():

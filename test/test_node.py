@@ -11,7 +11,7 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
-from helpers import bbox_values  # noqa: E402
+from iemd_ros.conversions import bbox_values  # noqa: E402
 from ros_harness import FRAME_ID, Driver, imu_msg, level, spinning, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
