@@ -27,6 +27,12 @@ overlap, L = 1): h = 1.0: 31.9 %; 1.2: 31.2 %; 1.414: 34.7 %; sqrt(2): 28.2 %;
 (Bolt2 50.6 vs 8.2 %): no value is reliably better, and h = 1 solves smaller
 EMDs.  The kernel is not scaled with the window: the scale search resamples
 the window instead (IemdTracker._search_scale says why).
+
+The kernel is the paper's, not learned from the first frame's background.  Scaling each bin of
+target and candidate by how unlike the background ring around the frame-1 target its patch is
+(mean shift's background-weighted histogram, as a per-position mask on the kernel) was measured
+at 19.1 % (background patches voting for their nearest target patch) and 20.9 % (distance to the
+nearest background patch) against 31.9 %, 12 OTB sequences.
 """
 from __future__ import annotations
 

@@ -42,6 +42,7 @@ class TrackerConfig:
     coarse_to_fine: bool = True  # first descend on the next pyramid level (wider convergence region)
     scale_step: float = 0.02  # relative scale variants tried at the converged position
     scale_range: float = 0.02  # largest relative scale change searched per frame, in scale_step steps (gyro run: 0.1)
+    # 12-sequence mean average overlap without the particles 26.7 %, at offset 0.25 27.0 %, trigger 1.0 24.5 %.
     n_particles: int = 4  # extra starting points for abrupt motion (section 6.1)
     particle_offset: float = 0.5  # their distance from the prediction, in window sizes
     # Thresholds relative to the background EMD; measured EMD/background while tracking
