@@ -18,6 +18,7 @@ import numpy as np
 from iemd_ros import IemdTracker
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
+from iemd_ros.candidate import CandidateModel
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
 GRADIENTS = ("paper", "envelope", "appearance")
@@ -41,8 +42,9 @@ def main():
             offsets = rng.uniform(-args.offset, args.offset, (args.starts, 2))
             tracker = IemdTracker()
             tracker.init(prev, seq.gt_boxes[k - 1])
+            context = tracker._context(pyramid)
             for offset in offsets:
-                start = tracker._candidate(pyramid, truth + offset, size)  # one start model for all three
+                start = CandidateModel(context, truth + offset, size)  # one start model for all three
                 for gradient in GRADIENTS:
                     tracker.config.gradient = gradient  # only the descent reads it
                     state = tracker._descend(start)

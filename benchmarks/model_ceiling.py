@@ -28,6 +28,7 @@ import numpy as np
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
+from iemd_ros.candidate import CandidateModel
 from iemd_ros.metrics import iou
 from iemd_ros.evaluation import sequence_names
 from iemd_ros.otb import default_root, load_sequence, read_frame
@@ -64,10 +65,10 @@ def measure(job):
         truth = np.asarray(seq.gt_boxes[k], dtype=float)
         frame = read_frame(seq.frame_paths[k])
         pyramid = ImagePyramid(to_gray(frame))
-        size = truth[2:]
+        context, size = tracker._context(pyramid), truth[2:]
 
         def emd(centre):
-            return tracker._candidate(pyramid, centre, size).emd()[0]
+            return CandidateModel(context, centre, size).emd()[0]
 
         def ncc(centre):
             window = pyramid.sample(centre, size, template_size).ravel()

@@ -23,6 +23,7 @@ from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.evaluation import IemdAdapter, evaluate_sequence
 from iemd_ros.boxes import box_centre
+from iemd_ros.candidate import CandidateModel
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
 
@@ -44,9 +45,9 @@ def discrimination(job, radius=40, grid=4):
     scores = []
     for k in picks:
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
-        center, size = box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
-        at_gt = tracker._candidate(pyramid, center, size).emd()[0]
-        others = [tracker._candidate(pyramid, center + (dx, dy), size).emd()[0]
+        context, center, size = tracker._context(pyramid), box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
+        at_gt = CandidateModel(context, center, size).emd()[0]
+        others = [CandidateModel(context, center + (dx, dy), size).emd()[0]
                   for dy in range(-radius, radius + 1, grid) for dx in range(-radius, radius + 1, grid)
                   if abs(dx) >= 0.3 * size[0] or abs(dy) >= 0.3 * size[1]]
         scores.append(100.0 * np.mean(np.array(others) < at_gt))

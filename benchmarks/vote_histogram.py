@@ -35,6 +35,7 @@ import numpy as np
 from iemd_ros import IemdTracker
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.boxes import box_centre
+from iemd_ros.candidate import CandidateModel
 from iemd_ros.emd import ground_distance, solve_emd
 from iemd_ros.histogram import candidate_weights
 from iemd_ros.evaluation import sequence_names
@@ -96,8 +97,8 @@ def measure(job):
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
         center, size = box_centre(seq.gt_boxes[k]), np.asarray(seq.gt_boxes[0][2:], dtype=float)  # frame-1 size
         accuracy = votes.vote_accuracy(pyramid.sample(center, size, tsize))
-        patch_bins = np.hypot(*grid_argmin(lambda c: tracker._candidate(pyramid, c, size).emd()[0], center, size,
-                                           OFFSETS))
+        context = tracker._context(pyramid)
+        patch_bins = np.hypot(*grid_argmin(lambda c: CandidateModel(context, c, size).emd()[0], center, size, OFFSETS))
         vote_bins = np.hypot(*grid_argmin(lambda c: votes.emd(pyramid.sample(c, size, tsize)), center, size, OFFSETS))
         rows.append((accuracy, patch_bins, vote_bins))
     frame0 = votes.vote_accuracy(tracker.dictionary.templates[0])

@@ -7,6 +7,10 @@ whenever the window sits on the target (a fixed patch lattice that is not
 re-sampled is misaligned between its grid points: on a pure 2.4 px
 translation its EMD minimum sat 1.2 px short of the truth).
 
+Everything but the window is fixed for one search on one frame: it is held
+in a :class:`SearchContext`, and a candidate model is ``CandidateModel(context,
+center, size)``.
+
 The gradient of eq. (10) is taken at the model's own position, treating its
 patches as fixed while the kernel centre y moves (as in mean shift);
 :meth:`CandidateModel.evaluate` therefore accepts small offsets y, which the
@@ -54,39 +58,66 @@ class TargetModel:
         return (self.eps**2).sum(1)
 
 
+@dataclass(frozen=True)
+class SearchContext:
+    """What the candidate windows of one search on one frame are sampled from and compared against.
+
+    The windows are resampled from ``pyramid`` ``coarse`` levels above its anti-aliasing level,
+    turned by ``angle`` (see ImagePyramid.sample; positions and gradients are in the window's own
+    axes), and cut into patches by ``layout``.  ``dictionary`` codes the patches
+    (:meth:`TemplateDictionary.code_weights`); None (the coarse stage) gives every patch code weight
+    1: only the kernel weights bins.  ``alpha`` weighs appearance against space in the ground
+    distance; ``bandwidth`` is the kernel's h.
+    """
+
+    pyramid: ImagePyramid
+    layout: PatchLayout
+    target: TargetModel
+    dictionary: TemplateDictionary | None
+    alpha: float
+    bandwidth: float
+    coarse: int = 0
+    angle: float = 0.0
+
+
 class CandidateModel:
-    """Patches, sparse codes and pooled weights of the window at ``center`` with ``size``, against ``target``."""
+    """Patches, sparse codes and pooled weights of the window at ``center`` with ``size`` in a search ``context``."""
 
-    def __init__(self, pyramid: ImagePyramid, layout: PatchLayout, center, size, target: TargetModel,
-                 dictionary: TemplateDictionary | None, alpha: float, bandwidth: float, coarse: int = 0,
-                 angle: float = 0.0):
-        """``dictionary`` codes the patches (:meth:`TemplateDictionary.code_weights`); None (the
-        coarse stage) gives every patch code weight 1: only the kernel weights bins.
-
-        ``angle``: the window's orientation in the image (see ImagePyramid.sample);
-        positions and gradients are in the window's own axes.
-        """
+    def __init__(self, context: SearchContext, center, size):
+        self.context = context
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
-        self.coarse = coarse  # pyramid levels above the anti-aliasing level it was sampled at
-        self.angle = angle
-        self.target = target
-        self.alpha = alpha
-        self.bandwidth = bandwidth
-        self.layout = layout
-        self._pyramid, self._dictionary = pyramid, dictionary
-        self.template = pyramid.sample(self.center, self.size, layout.template_size, coarse, angle)
-        self.eps = layout.extract(self.template)
-        self.pos = layout.positions()
+        self.template = context.pyramid.sample(self.center, self.size, self.layout.template_size, self.coarse,
+                                               self.angle)
+        self.eps = self.layout.extract(self.template)
+        self.pos = self.layout.positions()
+        dictionary = context.dictionary
         self.code_weights = np.ones(len(self.eps)) if dictionary is None else dictionary.code_weights(self.eps)
-        self.appearance_cost = alpha * appearance_distance(target.eps, self.eps, target.eps_sq_norms)
+        self.appearance_cost = context.alpha * appearance_distance(self.target.eps, self.eps, self.target.eps_sq_norms)
         self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
 
+    @property
+    def target(self) -> TargetModel:
+        return self.context.target
+
+    @property
+    def layout(self) -> PatchLayout:
+        return self.context.layout
+
+    @property
+    def coarse(self) -> int:
+        """Pyramid levels above the anti-aliasing level the window was sampled at."""
+        return self.context.coarse
+
+    @property
+    def angle(self) -> float:
+        """The window's orientation in the image (radians)."""
+        return self.context.angle
+
     def at(self, center, size=None) -> "CandidateModel":
-        """The same model (frame, target, dictionary, pyramid level, orientation) at another window:
+        """The model in the same context (frame, target, dictionary, pyramid level, orientation) at another window:
         Algorithm 1's next iterate, or a scale variant when ``size`` is given."""
-        return CandidateModel(self._pyramid, self.layout, center, self.size if size is None else size, self.target,
-                              self._dictionary, self.alpha, self.bandwidth, self.coarse, self.angle)
+        return CandidateModel(self.context, center, self.size if size is None else size)
 
     @cached_property
     def patch_jacobian(self) -> np.ndarray:
@@ -114,12 +145,12 @@ class CandidateModel:
         y = np.asarray(y, dtype=np.float64)
         if self._solved is not None and np.array_equal(self._solved[0], y):
             return self._solved[3].value, self._solved[3]
-        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, self.bandwidth)
+        w_c, dw_dy = candidate_weights(self.code_weights, self.pos, y, self.context.bandwidth)
         keep = np.flatnonzero(w_c > 0)
         if keep.size == 0:
             self._solved = None
             return np.inf, None
-        cost = _transport_cost(self.appearance_cost, keep, self.target.pos, self.pos, y, 1.0 - self.alpha)
+        cost = _transport_cost(self.appearance_cost, keep, self.target.pos, self.pos, y, 1.0 - self.context.alpha)
         solution: EmdSolution = solve_emd(self.target.weights, w_c[keep], cost, check=False)
         self._solved = (y, keep, dw_dy[keep], solution)
         return solution.value, solution
@@ -144,7 +175,7 @@ class CandidateModel:
             return emd_gradient(solution, dw_dy)
         if kind == "envelope":
             diff = self.target.pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
-            return envelope_gradient(solution, dw_dy, 2.0 * (1.0 - self.alpha) * diff)
+            return envelope_gradient(solution, dw_dy, 2.0 * (1.0 - self.context.alpha) * diff)
         if kind == "appearance":
             if np.any(y != 0):
                 raise ValueError("the appearance gradient is defined at the model's own position (y = 0)")
@@ -153,7 +184,7 @@ class CandidateModel:
             # normalized unit by size / 2: together -2 alpha (T / 2) sum r . d eps / d(template px).
             contraction = _appearance_contraction(flow.T @ self.target.eps, flow.sum(0), keep, self.eps,
                                                   self.patch_jacobian)
-            return -self.alpha * np.asarray(self.layout.template_size, dtype=np.float64) * contraction
+            return -self.context.alpha * np.asarray(self.layout.template_size, dtype=np.float64) * contraction
         raise ValueError(f"unknown gradient {kind!r}")
 
 

@@ -16,7 +16,7 @@ import numpy as np
 
 from .appearance import ImagePyramid, PatchLayout, to_gray, window_axes
 from .boxes import box_centre, centre_box, check_box
-from .candidate import CandidateModel, TargetModel
+from .candidate import CandidateModel, SearchContext, TargetModel
 from .template import TemplateDictionary
 
 
@@ -236,7 +236,8 @@ class IemdTracker:
         were easy, after which every frame counted as lost and, lost frames not
         updating it, it never recovered: 804 of 825 CMU desk frames.)
         """
-        values = [self._candidate(pyramid, self._center + offset * self._size, self._size).emd()[0]
+        context = self._context(pyramid)
+        values = [CandidateModel(context, self._center + offset * self._size, self._size).emd()[0]
                   for offset in _particle_offsets(4, 1.0)]
         finite = [v for v in values if np.isfinite(v)]
         return float(np.median(finite)) if finite else np.inf
@@ -255,15 +256,15 @@ class IemdTracker:
         self._target = TargetModel.from_patches(self.layout.positions(), self._target_eps, pooled,
                                                 self.config.kernel_bandwidth)
 
-    def _candidate(self, pyramid: ImagePyramid, center, size, coarse: bool = False, angle: float = 0.0
-                   ) -> CandidateModel:
-        """The candidate model at a window turned by ``angle``, against the full target (or the coarse stage's)."""
+    def _context(self, pyramid: ImagePyramid, angle: float = 0.0, coarse: bool = False) -> SearchContext:
+        """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the full target and
+        dictionary, or (``coarse``) the coarse stage's: one pyramid level up, its own target, no sparse coding."""
         cfg = self.config
         if coarse:
-            return CandidateModel(pyramid, self.layout, center, size, self._coarse_target, None, cfg.alpha,
-                                  cfg.kernel_bandwidth, coarse=1, angle=angle)
-        return CandidateModel(pyramid, self.layout, center, size, self._target, self.dictionary, cfg.alpha,
-                              cfg.kernel_bandwidth, angle=angle)
+            return SearchContext(pyramid, self.layout, self._coarse_target, None, cfg.alpha, cfg.kernel_bandwidth,
+                                 coarse=1, angle=angle)
+        return SearchContext(pyramid, self.layout, self._target, self.dictionary, cfg.alpha, cfg.kernel_bandwidth,
+                             angle=angle)
 
     def _search(self, pyramid: ImagePyramid, starts: np.ndarray, size, angle: float) -> _Descent:
         """Coarse-to-fine Algorithm 1 from one or more starts (N, 2); only the best-scored start is refined.
@@ -289,12 +290,13 @@ class IemdTracker:
         gain (12-sequence average overlap 31.3 vs 31.9 %: a wider basin also
         reaches distractors) and updates took 3x longer, so it was not kept.
         """
+        fine, coarse = self._context(pyramid, angle), self._context(pyramid, angle, coarse=True)
         scored, warnings = [], 0
         for start in starts:
             if self.config.coarse_to_fine:
-                coarse = self._descend(self._candidate(pyramid, start, size, coarse=True, angle=angle))
-                start, warnings = coarse.center, warnings + coarse.warnings
-            model = self._candidate(pyramid, start, size, angle=angle)
+                stage = self._descend(CandidateModel(coarse, start, size))
+                start, warnings = stage.center, warnings + stage.warnings
+            model = CandidateModel(fine, start, size)
             scored.append((*model.emd(), model))
         winner = min(scored, key=lambda item: item[0])[2]
         best = self._descend(winner)  # counts the winner's solve (cached from the scoring)

@@ -6,7 +6,7 @@ from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.boxes import box_centre
-from iemd_ros.candidate import CandidateModel
+from iemd_ros.candidate import CandidateModel, SearchContext
 from iemd_ros.emd import ground_distance, solve_emd, spatial_distance
 from iemd_ros.histogram import candidate_weights
 
@@ -21,9 +21,9 @@ def model_setup():
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
     center = box_centre(box)
-    model = CandidateModel(ImagePyramid(to_gray(frame1)), tracker.layout, center, np.array(box[2:], float),
-                           tracker._target, tracker.dictionary, tracker.config.alpha,
-                           tracker.config.kernel_bandwidth)
+    context = SearchContext(ImagePyramid(to_gray(frame1)), tracker.layout, tracker._target, tracker.dictionary,
+                            tracker.config.alpha, tracker.config.kernel_bandwidth)
+    model = CandidateModel(context, center, np.array(box[2:], float))
     return tracker, model
 
 
@@ -31,14 +31,17 @@ def test_candidate_at_is_the_same_model_at_another_window(model_setup):
     """CandidateModel.at (Algorithm 1's next iterate, a scale variant) keeps the frame, target,
     dictionary, pyramid level and orientation, and equals a model built at that window."""
     tracker, model = model_setup
-    pyramid, cfg = model._pyramid, tracker.config
-    turned = CandidateModel(pyramid, tracker.layout, model.center, model.size, tracker._target, None, cfg.alpha,
-                            cfg.kernel_bandwidth, coarse=1, angle=0.3)
+    pyramid, cfg = model.context.pyramid, tracker.config
+
+    def context(dictionary, coarse=0, angle=0.0):
+        return SearchContext(pyramid, tracker.layout, tracker._target, dictionary, cfg.alpha, cfg.kernel_bandwidth,
+                             coarse=coarse, angle=angle)
+
+    turned = CandidateModel(context(None, coarse=1, angle=0.3), model.center, model.size)
     for start, dictionary in ((model, tracker.dictionary), (turned, None)):
         center, size = start.center + (1.7, -0.4), start.size * 1.02
         moved = start.at(center, size)
-        built = CandidateModel(pyramid, tracker.layout, center, size, tracker._target, dictionary, cfg.alpha,
-                               cfg.kernel_bandwidth, coarse=start.coarse, angle=start.angle)
+        built = CandidateModel(context(dictionary, coarse=start.coarse, angle=start.angle), center, size)
         assert (moved.coarse, moved.angle) == (start.coarse, start.angle)
         np.testing.assert_array_equal(moved.template, built.template)
         np.testing.assert_array_equal(moved.code_weights, built.code_weights)
@@ -106,12 +109,12 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     tracker = IemdTracker(TrackerConfig(gradient="appearance"))
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
-    pyramid = ImagePyramid(to_gray(frame1))
+    context = tracker._context(ImagePyramid(to_gray(frame1)))
     center = box_centre(box)
     size = np.array(box[2:], float)
 
     def emd(c):
-        value, grad, _ = tracker._candidate(pyramid, c, size).evaluate("appearance")
+        value, grad, _ = CandidateModel(context, c, size).evaluate("appearance")
         return value, grad / (size / 2)  # per image pixel
 
     _, grad = emd(center)
