@@ -7,6 +7,12 @@ duality ``D* = <u, w_T> + <v, w_C>``, so ``v`` is the vector ``M`` of eq. (9)
 that expresses the EMD as a linear function of the candidate weights on the
 optimal basis, and the paper's gradient eq. (10) is ``sum_v v_v dw_C,v/dy``.
 Non-optimal solver exits are reported in :class:`EmdSolution`, never hidden.
+
+Both histograms are normalized and all their mass is moved, as in the paper.  A partial
+matching that moves only a share m of it (one dummy bin on each side, free to reach, so that
+an occluded part of the window need not be matched; the duals and gradients stay valid) was
+measured over the 12 OTB sequences at m = 0.9 / 0.8 / 0.7 / 0.5: 28.5 / 16.9 / 23.8 / 20.9 %
+mean average overlap against 31.9 % (Woman, occluded by a car, stays at 12-15 %).
 """
 from __future__ import annotations
 
