@@ -22,6 +22,7 @@ from 20.4 % to 9.2 %, CSRT's from 51.3 % to 51.1 %).
 Usage::
 
     iemd-eval [ROOT_OR_SEQ ...] [--trackers iemd,csrt,kcf] [--sequences Car4,Bolt2] [--max-frames N] [--out DIR]
+              [--config config/tracker.yaml]
 """
 from __future__ import annotations
 
@@ -39,6 +40,8 @@ import numpy as np
 from iemd_ros.cli import CliParser, cli_main
 from iemd_ros.metrics import OTB_THRESHOLDS, PRECISION_THRESHOLD, SequenceScores, score_sequence, valid_boxes
 from iemd_ros.otb import Sequence, default_root, is_sequence_folder, list_sequences, load_sequence
+from iemd_ros.pipeline import PipelineConfig
+from iemd_ros.tracker import IemdTracker, TrackerConfig
 
 DEFAULT_TRACKERS = ("iemd", "csrt", "kcf")
 DEFAULT_OUT = Path("out") / "eval"
@@ -72,11 +75,10 @@ class OpenCVTracker:
 
 
 class IemdAdapter:
-    """Adapter for :class:`iemd_ros.IemdTracker` (imported lazily; no gyro prior in OTB)."""
+    """Adapter for :class:`iemd_ros.IemdTracker` with a :class:`~iemd_ros.TrackerConfig` (None: the
+    defaults); no gyro prior in OTB."""
 
     def __init__(self, config=None):
-        from iemd_ros import IemdTracker  # noqa: PLC0415 - lazy: optional while the tracker is written
-
         self._tracker = IemdTracker(config)
 
     def init(self, frame: np.ndarray, box: np.ndarray) -> None:
@@ -108,12 +110,13 @@ TRACKERS: dict[str, Callable[[], TrackerAdapter]] = {
 }
 
 
-def make_tracker(name: str) -> TrackerAdapter:
-    """Build a tracker adapter by name; ValueError for an unknown or unavailable tracker."""
+def make_tracker(name: str, iemd_config=None) -> TrackerAdapter:
+    """Build a tracker adapter by name (``iemd_config``: the iEMD tracker's TrackerConfig, None for the
+    defaults); ValueError for an unknown or unavailable tracker."""
     if name not in TRACKERS:
         raise ValueError(f"unknown tracker {name!r} (known: {', '.join(TRACKERS)})")
     try:
-        return TRACKERS[name]()
+        return IemdAdapter(iemd_config) if name == "iemd" else TRACKERS[name]()
     except ImportError as exc:
         raise ValueError(f"tracker {name!r} is not available: {exc}") from None
 
@@ -242,6 +245,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="comma-separated sequence names (Jogging selects Jogging-1 and Jogging-2)")
     p.add_argument("--max-frames", type=_positive_int, default=None, help="evaluate only the first N frames")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output folder (default out/eval)")
+    p.add_argument("--config", type=Path, default=None,
+                   help="iEMD parameters: the node's parameter file (config/tracker.yaml) or {tracker: {...}}; "
+                        "its tracker.* values apply (OTB has no IMU)")
     return p
 
 
@@ -289,14 +295,18 @@ def sequence_names(wanted: str | None) -> list[str]:
     return [seq.name for seq in collect_sequences([], wanted.split(",") if wanted else None)]
 
 
-def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print) -> dict:
-    """Run every tracker on every sequence, write ``results.json`` and success plots into ``out``."""
+def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, iemd_config=None) -> dict:
+    """Run every tracker on every sequence, write ``results.json`` and success plots into ``out``.
+
+    ``iemd_config``: the iEMD tracker's TrackerConfig (None: the defaults), recorded in ``results.json``.
+    """
+    iemd_config = iemd_config if iemd_config is not None else TrackerConfig()
     out.mkdir(parents=True, exist_ok=True)
     results: dict[str, dict] = {t: {} for t in trackers}
     per_seq_scores: dict[str, list[SequenceScores]] = {t: [] for t in trackers}
     for seq in sequences:
         for trk in trackers:
-            scores, run = evaluate_sequence(seq, make_tracker(trk))
+            scores, run = evaluate_sequence(seq, make_tracker(trk, iemd_config))
             per_seq_scores[trk].append(scores)
             entry = scores.to_dict()
             entry.update(
@@ -328,6 +338,7 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
         },
         "opencv_version": cv2.__version__,
         "trackers": trackers,
+        "iemd_config": iemd_config.to_dict(),
         "sequences": [s.name for s in sequences],
         "ground_truth": {s.name: s.gt_boxes.tolist() for s in sequences},
         "frame_numbers": {s.name: list(s.frame_numbers) for s in sequences},
@@ -349,12 +360,14 @@ def main(argv: list[str] | None = None) -> int:
         trackers = list(dict.fromkeys(args.trackers))
         for t in trackers:
             make_tracker(t)  # fail early on an unknown tracker or one that cannot be imported
+        iemd_config = PipelineConfig.from_yaml(args.config).tracker if args.config else None
         sequences = collect_sequences(args.inputs, args.sequences)
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
         t_start = time.perf_counter()
-        print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) -> {args.out}")
-        doc = evaluate(sequences, trackers, args.out)  # unreadable image, unwritable --out: one line, exit 2
+        print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) -> {args.out}"
+              + (f" (iEMD parameters from {args.config})" if args.config else ""))
+        doc = evaluate(sequences, trackers, args.out, iemd_config=iemd_config)  # unreadable image, unwritable --out: one line, exit 2
         print()
         print(format_table(doc["results"], trackers, doc["sequences"]))
         print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}")

@@ -34,6 +34,7 @@ import threading
 import time
 from collections import deque
 from dataclasses import asdict, dataclass, field, fields
+from pathlib import Path
 
 import numpy as np
 
@@ -129,6 +130,30 @@ class PipelineConfig:
         v["tracker"] = TrackerConfig.from_dict(v.get("tracker", {}))
         v["gyro"] = gyro_config_from_dict(v.get("gyro", {}))
         return cls(**v)
+
+    @classmethod
+    def from_yaml(cls, path) -> "PipelineConfig":
+        """From a YAML file: either ``{tracker: {...}, gyro: {...}, use_gyro: ..., imu_wait_ms: ...}``
+        (:meth:`from_dict`) or the node's ROS parameter file (``config/tracker.yaml``:
+        ``<node>: ros__parameters: ...``), of which the pipeline's keys are used (node-only parameters
+        such as ``initial_box``, ``class_id`` or ``reliable_qos`` are ignored).  ValueError for a file
+        that cannot be read or holds invalid values."""
+        import yaml  # noqa: PLC0415 - only the command-line tools read configuration files
+
+        path = Path(path)
+        try:
+            values = yaml.safe_load(path.read_text()) or {}
+        except (OSError, yaml.YAMLError) as exc:
+            raise ValueError(f"cannot read config {path}: {exc}") from None
+        if not isinstance(values, dict):
+            raise ValueError(f"config {path} must be a mapping")
+        ros = [v["ros__parameters"] for v in values.values() if isinstance(v, dict) and "ros__parameters" in v]
+        if ros:
+            if len(ros) > 1:
+                raise ValueError(f"config {path} holds parameters of {len(ros)} nodes; keep the tracker's only")
+            keys = {f.name for f in fields(cls)}
+            values = {k: v for k, v in (ros[0] or {}).items() if k in keys}
+        return cls.from_dict(values)
 
     def to_dict(self) -> dict:
         d = {f.name: getattr(self, f.name) for f in fields(self)}

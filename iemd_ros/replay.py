@@ -42,7 +42,7 @@ import math
 import sys
 import time
 from collections import deque
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import cv2
@@ -433,35 +433,12 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
-def load_config(path) -> PipelineConfig:
-    """Pipeline configuration from YAML: either ``{tracker: {...}, gyro: {...}, use_gyro: ..., imu_wait_ms: ...}``
-    (:meth:`PipelineConfig.from_dict`) or the node's ROS parameter file (``config/tracker.yaml``:
-    ``<node>: ros__parameters: ...``), of which the pipeline's keys are used (node-only parameters such
-    as ``initial_box``, ``class_id`` or ``reliable_qos`` do not apply to a replay and are ignored)."""
-    import yaml
-
-    path = Path(path)
-    try:
-        values = yaml.safe_load(path.read_text()) or {}
-    except (OSError, yaml.YAMLError) as exc:
-        raise ValueError(f"cannot read config {path}: {exc}") from None
-    if not isinstance(values, dict):
-        raise ValueError(f"config {path} must be a mapping")
-    ros = [v["ros__parameters"] for v in values.values() if isinstance(v, dict) and "ros__parameters" in v]
-    if ros:
-        if len(ros) > 1:
-            raise ValueError(f"config {path} holds parameters of {len(ros)} nodes; keep the tracker's only")
-        keys = {f.name for f in fields(PipelineConfig)}
-        values = {k: v for k, v in (ros[0] or {}).items() if k in keys}
-    return PipelineConfig.from_dict(values)
-
-
 def main(argv: list[str] | None = None) -> int:
     def body() -> int:
         args, _ = split_ros_args(argv)      # from `ros2 run` / launch: the replay has no ROS arguments
         a = build_parser().parse_args(args)
         box = parse_box(a.init)
-        cfg = load_config(a.config) if a.config else PipelineConfig()
+        cfg = PipelineConfig.from_yaml(a.config) if a.config else PipelineConfig()
         if a.time_offset_ms is not None:
             cfg = replace(cfg, gyro=replace(cfg.gyro, time_offset_ns=int(round(a.time_offset_ms * 1e6))))
         camera = CameraModel.from_yaml(a.camera_yaml) if a.camera_yaml else None

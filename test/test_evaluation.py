@@ -5,9 +5,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from helpers import PNG_SIGNATURE, run_module
+import yaml
+from helpers import PNG_SIGNATURE, REPO, run_module
 
-from iemd_ros import evaluation
+from iemd_ros import TrackerConfig, evaluation
 from iemd_ros.evaluation import main, make_tracker, run_tracker, sequence_names
 from iemd_ros.otb import load_sequence
 
@@ -114,6 +115,24 @@ def test_cli_real_excerpt_csrt_kcf(otb_root, tmp_path, capsys):
     assert "MEAN (1)" in table and "csrt" in table and "kcf" in table
 
 
+def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
+    """--config takes the node's config/tracker.yaml; its tracker.* values are the ones iEMD runs with."""
+    params = yaml.safe_load((REPO / "config" / "tracker.yaml").read_text())
+    node = next(iter(params))
+    params[node]["ros__parameters"]["tracker"] = {"scale_step": 0.0}
+    (tmp_path / "p.yaml").write_text(yaml.safe_dump(params))
+    common = [str(otb_root), "--trackers", "iemd", "--sequences", "Car4", "--max-frames", "40"]
+    assert main(common + ["--out", str(tmp_path / "default")]) == 0
+    assert main(common + ["--out", str(tmp_path / "fixed"), "--config", str(tmp_path / "p.yaml")]) == 0
+    default, fixed = (json.loads((tmp_path / d / "results.json").read_text()) for d in ("default", "fixed"))
+    assert TrackerConfig.from_dict(default["iemd_config"]) == TrackerConfig()
+    assert TrackerConfig.from_dict(fixed["iemd_config"]) == TrackerConfig(scale_step=0.0)
+    sizes = {d: np.array(doc["results"]["iemd"]["Car4"]["boxes"])[:, 2:]
+             for d, doc in (("default", default), ("fixed", fixed))}
+    assert np.ptp(sizes["default"], axis=0).max() > 1.0  # the default scale search resizes the window
+    np.testing.assert_allclose(sizes["fixed"], np.broadcast_to(sizes["fixed"][0], sizes["fixed"].shape))
+
+
 @pytest.mark.parametrize(
     "argv, match",
     [
@@ -123,6 +142,7 @@ def test_cli_real_excerpt_csrt_kcf(otb_root, tmp_path, capsys):
         (["--max-frames", "1", "--trackers", "kcf"], "must be >= 2"),
         (["--bogus"], "unrecognized arguments"),
         (["/no/such/dir", "--trackers", "kcf"], "neither an OTB root nor a sequence folder"),
+        (["--config", "/no/such/params.yaml", "--trackers", "kcf"], "cannot read config"),
     ],
 )
 def test_bad_arguments_exit_2_one_line(argv, match, capsys):
