@@ -4,7 +4,7 @@ The functions read message fields by name and never import a message type, so ``
 (``data`` is an ``array.array`` or ``bytes``), ``rosbags`` messages (``data`` is a numpy array) and
 hand-made values all work:
 
-    frame = image_from_msg(msg)                  # image_to_array of the Image's fields
+    frame = image_from_msg(msg)                  # an Image (image_to_array) or a CompressedImage (compressed_to_array)
     t_ns, gyro, cov0 = imu_sample(msg)           # the arguments of TrackingPipeline.add_imu_message
     camera = camera_model_from_msg(msg)          # CameraInfo, cached per content (ROS 1 or 2 field names)
     fill_image_msg(Image(), frame)               # a frame into an Image's pixel fields
@@ -18,12 +18,13 @@ from __future__ import annotations
 from functools import lru_cache
 from typing import NamedTuple
 
+import cv2
 import numpy as np
 
 from .camera import CameraModel
 from .boxes import box_centre, centre_box, check_box
 
-__all__ = ["ENCODINGS", "image_to_array", "array_to_image_fields", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
+__all__ = ["ENCODINGS", "image_to_array", "compressed_to_array", "array_to_image_fields", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
            "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
            "bbox_values", "fill_bbox",
            "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
@@ -69,9 +70,7 @@ def image_to_array(encoding: str, height: int, width: int, step: int, data, is_b
         raise ValueError(f"image data has {len(buf)} bytes, expected step*height = {step}*{height} = {step * height}")
     raw = np.frombuffer(buf, dtype=np.uint8).reshape(height, step)[:, :row]
     if depth == 2:
-        mono = raw.view(">u2" if is_bigendian else "<u2").reshape(height, width)
-        shift = max(0, int(mono.max()).bit_length() - 8)
-        return (mono >> shift).astype(np.uint8)
+        return _to_8bit(raw.view(">u2" if is_bigendian else "<u2").reshape(height, width))
     pix = raw.reshape(height, width, channels) if channels > 1 else raw
     if encoding in ("mono8", "bgr8"):
         return pix
@@ -80,6 +79,39 @@ def image_to_array(encoding: str, height: int, width: int, step: int, data, is_b
     if encoding == "bgra8":
         return np.ascontiguousarray(pix[..., :3])
     return np.ascontiguousarray(pix[..., 2::-1])      # rgba8
+
+
+def _to_8bit(pixels: np.ndarray) -> np.ndarray:
+    """16-bit pixels -> uint8 by the right shift that puts the highest set bit at bit 7 (see image_to_array)."""
+    shift = max(0, int(pixels.max()).bit_length() - 8)
+    return (pixels >> shift).astype(np.uint8)
+
+
+def compressed_to_array(fmt: str, data) -> np.ndarray:
+    """``sensor_msgs/CompressedImage`` fields -> tracker frame (``HxW`` or ``HxWx3`` uint8 BGR).
+
+    ``fmt`` is as image_transport's compressed plugin writes it (``"jpeg"``, ``"png"`` or e.g.
+    ``"rgb8; jpeg compressed bgr8"``); the data are decoded by what they are (``cv2.imdecode``), which
+    gives BGR whatever the source encoding (the plugin stores colour as bgr8, and the codec's own
+    channel order is undone by OpenCV).  An alpha channel is dropped; 16-bit PNG (mono16/bgr16) is
+    reduced to 8 bits as mono16 in :func:`image_to_array`.  Raises ValueError for data that do not
+    decode, and for ``compressedDepth`` (depth maps, not camera images).
+    """
+    if "compresseddepth" in str(fmt).lower():
+        raise ValueError(f"compressed image format {fmt!r} is a depth map (compressedDepth), not a camera image")
+    buf = np.frombuffer(_as_bytes(data), dtype=np.uint8)
+    if buf.size == 0:
+        raise ValueError(f"compressed image ({fmt!r}) has no data")
+    img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+    if img is None:
+        raise ValueError(f"cannot decode the compressed image (format {fmt!r}, {buf.size} bytes)")
+    if img.dtype == np.uint16:
+        img = _to_8bit(img)
+    elif img.dtype != np.uint8:
+        raise ValueError(f"compressed image ({fmt!r}) decodes to {img.dtype} pixels; expected 8 or 16 bits")
+    if img.ndim == 3 and img.shape[2] == 4:
+        img = img[..., :3]
+    return np.ascontiguousarray(img)
 
 
 def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dict:
@@ -153,7 +185,10 @@ def stamp_to_ns(sec: int, nanosec: int) -> int:
 
 
 def image_from_msg(msg) -> np.ndarray:
-    """A ``sensor_msgs/Image`` (rclpy or rosbags message) -> tracker frame, by :func:`image_to_array`."""
+    """A ``sensor_msgs/Image`` (:func:`image_to_array`) or ``sensor_msgs/CompressedImage``
+    (:func:`compressed_to_array`), rclpy or rosbags message -> tracker frame."""
+    if hasattr(msg, "format"):  # CompressedImage: header, format, data
+        return compressed_to_array(msg.format, msg.data)
     return image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, bool(msg.is_bigendian))
 
 

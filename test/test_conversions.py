@@ -2,12 +2,13 @@
 import array
 from types import SimpleNamespace
 
+import cv2
 import numpy as np
 import pytest
 
 from iemd_ros.boxes import box_centre, centre_box, check_box
 from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, bbox_values, box_to_bbox,
-                                  camera_model_from_info, detection_values, fill_bbox, fill_image_msg,
+                                  camera_model_from_info, compressed_to_array, detection_values, fill_bbox, fill_image_msg,
                                   image_from_msg, image_to_array, imu_sample, ns_to_stamp, stamp_to_ns)
 from iemd_ros.pipeline import FrameResult
 
@@ -156,6 +157,49 @@ def test_check_box_names_what_is_wrong(box, message):
         check_box(box, "marker")
     assert str(exc.value) == message
     np.testing.assert_array_equal(check_box([1, 2, 3, 4]), [1.0, 2.0, 3.0, 4.0])
+
+
+def _encoded(ext, img, *params):
+    ok, buf = cv2.imencode(ext, img, list(params))
+    assert ok
+    return buf.tobytes()
+
+
+def test_compressed_images_decode_to_bgr_frames():
+    rng = np.random.default_rng(3)
+    bgr = rng.integers(0, 256, (24, 32, 3), dtype=np.uint8)
+    grey = bgr[..., 1].copy()
+    # PNG is lossless: exactly the frame back, colour (BGR) and grey, and an alpha channel dropped.
+    np.testing.assert_array_equal(compressed_to_array("bgr8; png compressed bgr8", _encoded(".png", bgr)), bgr)
+    np.testing.assert_array_equal(compressed_to_array("png", _encoded(".png", grey)), grey)
+    bgra = np.dstack([bgr, np.full(grey.shape, 7, np.uint8)])
+    np.testing.assert_array_equal(compressed_to_array("bgra8; png compressed bgra8", _encoded(".png", bgra)), bgr)
+    # 16-bit PNG (a 12-bit sensor): the same 8 bits as the raw mono16 message.
+    mono16 = rng.integers(0, 4096, (24, 32), dtype=np.uint16)
+    np.testing.assert_array_equal(compressed_to_array("mono16; png compressed mono16", _encoded(".png", mono16)),
+                                  image_to_array("mono16", 24, 32, 64, mono16.tobytes()))
+    # JPEG: lossy, but the channel order holds (a pure blue patch stays blue).
+    blue = np.zeros((32, 32, 3), np.uint8)
+    blue[..., 0] = 255
+    out = compressed_to_array("rgb8; jpeg compressed bgr8", _encoded(".jpg", blue, cv2.IMWRITE_JPEG_QUALITY, 95))
+    assert out.shape == blue.shape and out[..., 0].min() > 240 and out[..., 1:].max() < 15
+
+
+@pytest.mark.parametrize("fmt, data, match", [
+    ("jpeg", b"", "has no data"),
+    ("jpeg", b"\xff\xd8 not really a jpeg", "cannot decode the compressed image"),
+    ("16UC1; compressedDepth png", b"\x00" * 16, "depth map"),
+])
+def test_bad_compressed_images_are_refused(fmt, data, match):
+    with pytest.raises(ValueError, match=match):
+        compressed_to_array(fmt, data)
+
+
+def test_compressed_image_message():
+    CompressedImage = pytest.importorskip("sensor_msgs.msg").CompressedImage
+    bgr = np.random.default_rng(4).integers(0, 256, (12, 20, 3), dtype=np.uint8)
+    msg = CompressedImage(format="bgr8; png compressed bgr8", data=_encoded(".png", bgr))
+    np.testing.assert_array_equal(image_from_msg(msg), bgr)
 
 
 def test_image_and_imu_messages():
