@@ -24,7 +24,7 @@ import numpy as np
 from .camera import CameraModel
 from .boxes import box_centre, centre_box, check_box
 
-__all__ = ["ENCODINGS", "image_to_array", "compressed_to_array", "array_to_image_fields", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
+__all__ = ["ENCODINGS", "image_to_array", "compressed_to_array", "array_to_image_fields", "array_to_compressed_fields", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
            "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
            "bbox_values", "fill_bbox",
            "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
@@ -133,6 +133,25 @@ def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dic
     channels = 1 if frame.ndim == 2 else 3
     return dict(encoding=encoding, height=h, width=w, step=w * channels, is_bigendian=0,
                 data=np.ascontiguousarray(frame).tobytes())
+
+
+def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: int = 95) -> dict:
+    """Tracker frame -> ``sensor_msgs/CompressedImage`` fields as image_transport's compressed plugin
+    writes them: ``format`` ``"bgr8; jpeg compressed bgr8"`` (``mono8`` for ``HxW``; ``png`` is
+    lossless) and the encoded ``data`` as ``bytes``.  ``quality``: JPEG quality, 1-100."""
+    frame = np.asarray(frame)
+    if frame.dtype != np.uint8 or frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
+        raise ValueError(f"frame must be HxW or HxWx3 uint8, got {frame.dtype} {frame.shape}")
+    if codec not in ("jpeg", "png"):
+        raise ValueError(f"codec must be 'jpeg' or 'png', got {codec!r}")
+    if not 1 <= int(quality) <= 100:
+        raise ValueError(f"JPEG quality must be in [1, 100], got {quality}")
+    params = [cv2.IMWRITE_JPEG_QUALITY, int(quality)] if codec == "jpeg" else []
+    ok, buf = cv2.imencode(".jpg" if codec == "jpeg" else ".png", frame, params)
+    if not ok:
+        raise ValueError(f"OpenCV could not encode a {frame.shape} frame as {codec}")
+    encoding = "mono8" if frame.ndim == 2 else "bgr8"
+    return dict(format=f"{encoding}; {codec} compressed {encoding}", data=buf.tobytes())
 
 
 def fill_image_msg(msg, frame: np.ndarray, encoding: str | None = None):

@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from iemd_ros.boxes import box_centre, centre_box, check_box
-from iemd_ros.conversions import (array_to_image_fields, bbox_to_box, bbox_values, box_to_bbox,
-                                  camera_model_from_info, compressed_to_array, detection_values, fill_bbox, fill_image_msg,
-                                  image_from_msg, image_to_array, imu_sample, ns_to_stamp, stamp_to_ns)
+from iemd_ros.conversions import (array_to_compressed_fields, array_to_image_fields, bbox_to_box, bbox_values,
+                                  box_to_bbox, camera_model_from_info, compressed_to_array, detection_values,
+                                  fill_bbox, fill_image_msg, image_from_msg, image_to_array, imu_sample, ns_to_stamp,
+                                  stamp_to_ns)
 from iemd_ros.pipeline import FrameResult
 
 
@@ -195,10 +196,27 @@ def test_bad_compressed_images_are_refused(fmt, data, match):
         compressed_to_array(fmt, data)
 
 
+def test_frames_compress_as_image_transport_writes_them():
+    rng = np.random.default_rng(5)
+    bgr = rng.integers(0, 256, (16, 24, 3), dtype=np.uint8)
+    png = array_to_compressed_fields(bgr, "png")
+    assert png["format"] == "bgr8; png compressed bgr8" and isinstance(png["data"], bytes)
+    np.testing.assert_array_equal(compressed_to_array(png["format"], png["data"]), bgr)
+    grey = array_to_compressed_fields(bgr[..., 0].copy(), "jpeg", quality=100)
+    assert grey["format"] == "mono8; jpeg compressed mono8"
+    assert np.abs(compressed_to_array(grey["format"], grey["data"]).astype(int) - bgr[..., 0]).mean() < 2.0
+    small, large = (len(array_to_compressed_fields(bgr, "jpeg", quality=q)["data"]) for q in (10, 95))
+    assert small < large                                                    # the quality is applied
+    for args, match in [((bgr, "webp"), "codec must be"), ((bgr, "jpeg", 0), "quality must be"),
+                        ((bgr.astype(np.float32),), "uint8")]:
+        with pytest.raises(ValueError, match=match):
+            array_to_compressed_fields(*args)
+
+
 def test_compressed_image_message():
     CompressedImage = pytest.importorskip("sensor_msgs.msg").CompressedImage
     bgr = np.random.default_rng(4).integers(0, 256, (12, 20, 3), dtype=np.uint8)
-    msg = CompressedImage(format="bgr8; png compressed bgr8", data=_encoded(".png", bgr))
+    msg = CompressedImage(**array_to_compressed_fields(bgr, "png"))
     np.testing.assert_array_equal(image_from_msg(msg), bgr)
 
 
