@@ -2,7 +2,9 @@
 
 Topics (relative names, remap with ``-r image:=/camera/image_raw`` ...):
 
-* subscribes ``image`` (sensor_msgs/Image: mono8, mono16, bgr8, rgb8, bgra8, rgba8), ``imu``
+* subscribes ``image`` (sensor_msgs/Image: mono8, mono16, bgr8, rgb8, bgra8, rgba8; with
+  ``image_transport`` "compressed": sensor_msgs/CompressedImage on ``<image>/compressed``, jpeg or
+  png as image_transport's compressed plugin publishes them), ``imu``
   (sensor_msgs/Imu, angular velocity in the IMU frame), ``camera_info`` (sensor_msgs/CameraInfo: K,
   plumb_bob D); sensor-data QoS (best effort) unless ``reliable_qos`` is true.
 * publishes ``detections`` (vision_msgs/Detection2DArray, the image's header, one Detection2D while
@@ -36,7 +38,7 @@ from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
-from sensor_msgs.msg import CameraInfo, Image, Imu
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithPose
 
@@ -133,6 +135,9 @@ class TrackerNode(Node):
         self._declare_all()
         cfg = self._pipeline_config({})           # ValueError: invalid parameter file / overrides
         self._initial_box = self._check_initial_box(self.get_parameter("initial_box").value)
+        transport = self.get_parameter("image_transport").value
+        if transport not in ("raw", "compressed"):
+            raise ValueError(f"image_transport must be 'raw' or 'compressed', got {transport!r}")
         self.pipeline = TrackingPipeline(cfg)
         p = self.get_parameter
         self._class_id = p("class_id").value
@@ -141,7 +146,7 @@ class TrackerNode(Node):
         self._timeout_s = p("input_timeout_s").value
 
         self._cond = threading.Condition()
-        self._latest: Image | None = None           # single-slot buffer of the newest frame
+        self._latest: Image | CompressedImage | None = None  # single-slot buffer of the newest frame
         self._ring: deque = deque(maxlen=p("frame_buffer_size").value)  # recent frames for ~/init
         self._ops: list = []                         # requests for the worker (config, reset, init)
         self._pending_box = self._initial_box        # initial_box to apply to the next frame
@@ -161,7 +166,13 @@ class TrackerNode(Node):
         self._det_pub = self.create_publisher(Detection2DArray, "detections", 10)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._debug_pub = self.create_publisher(Image, "~/debug_image", 1)
-        self.create_subscription(Image, "image", self._on_image, sensor_qos)
+        # image_transport's naming: the compressed stream of the (remapped) image topic is <image>/compressed.
+        if transport == "compressed":
+            self._image_topic = self.resolve_topic_name("image") + "/compressed"
+            self.create_subscription(CompressedImage, self._image_topic, self._on_image, sensor_qos)
+        else:
+            self._image_topic = self.resolve_topic_name("image")
+            self.create_subscription(Image, self._image_topic, self._on_image, sensor_qos)
         self.create_subscription(Imu, "imu", self._on_imu, imu_qos)
         self.create_subscription(CameraInfo, "camera_info", self._on_camera_info, sensor_qos)
         self.create_subscription(Detection2D, "~/init", self._on_init, 10)
@@ -172,7 +183,7 @@ class TrackerNode(Node):
         self._worker = threading.Thread(target=self._work, name="iemd_tracker_worker", daemon=True)
         self._worker.start()
         self.get_logger().info(
-            f"tracking '{self.resolve_topic_name('image')}' -> '{self.resolve_topic_name('detections')}' "
+            f"tracking '{self._image_topic}' -> '{self.resolve_topic_name('detections')}' "
             f"(gyro {'on' if cfg.use_gyro else 'off'}, {'reliable' if p('reliable_qos').value else 'sensor-data'} "
             f"QoS); {'initial box ' + str(self._initial_box) if self._initial_box else 'waiting for ~/init'}")
 
@@ -203,6 +214,8 @@ class TrackerNode(Node):
         node_params = [
             ("reliable_qos", False, ("reliable QoS for image/imu/camera_info instead of sensor-data (best effort)",
                                      None), True),
+            ("image_transport", "raw", ('"raw": sensor_msgs/Image on image; "compressed": sensor_msgs/CompressedImage '
+                                        '(jpeg/png) on <image>/compressed', None), True),
             ("frame_buffer_size", 30, ("recent frames kept for ~/init", (1, 1000)), True),
             ("init_tolerance_ms", 20.0, ("largest stamp difference between ~/init and a buffered frame, ms",
                                          (0.0, 10_000.0)), False),
@@ -255,7 +268,7 @@ class TrackerNode(Node):
         return SetParametersResult(successful=True)
 
     # ------------------------------------------------------------------ callbacks (fast)
-    def _on_image(self, msg: Image) -> None:
+    def _on_image(self, msg: Image | CompressedImage) -> None:
         now = time.monotonic()
         self._last_image_wall = now
         with self._cond:
@@ -371,7 +384,7 @@ class TrackerNode(Node):
         self._note = ""
         self.get_logger().info(f"target initialized from ~/init at {box} on the frame stamped {int(stamps[i])} ns")
 
-    def _handle_frame(self, msg: Image, received) -> None:
+    def _handle_frame(self, msg: Image | CompressedImage, received) -> None:
         stamp = stamp_ns(msg.header)
         try:
             frame = image_from_msg(msg)
@@ -406,7 +419,7 @@ class TrackerNode(Node):
         self._publish_debug(msg, frame, result)
 
     # ------------------------------------------------------------------ output
-    def _publish(self, img: Image, result: FrameResult | None, received) -> None:
+    def _publish(self, img: Image | CompressedImage, result: FrameResult | None, received) -> None:
         """The image's Detection2DArray: one detection while ``result`` is tracking, else empty."""
         out = Detection2DArray()
         out.header = img.header
@@ -427,7 +440,7 @@ class TrackerNode(Node):
         if received is not None:
             self._latency_ms.append((time.monotonic() - received) * 1e3)
 
-    def _publish_debug(self, img: Image, frame: np.ndarray, result: FrameResult) -> None:
+    def _publish_debug(self, img: Image | CompressedImage, frame: np.ndarray, result: FrameResult) -> None:
         if self._debug_pub.get_subscription_count() == 0 or self._stop:
             return
         canvas = draw_result(frame, result)
@@ -446,7 +459,7 @@ class TrackerNode(Node):
             if kind == "image input":
                 since = now - (self._last_image_wall or self._started)
                 values["latency_ms_mean"] = f"{np.mean(self._latency_ms):.1f}" if self._latency_ms else "nan"
-                values["topic"] = self.resolve_topic_name("image")
+                values["topic"] = self._image_topic
                 if since > self._timeout_s and level < ERROR:
                     note = (f"no image on {values['topic']} for {since:.1f} s" if self._last_image_wall
                             else f"no image received on {values['topic']} yet")

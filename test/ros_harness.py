@@ -14,11 +14,11 @@ from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.srv import SetParameters
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy
-from sensor_msgs.msg import CameraInfo, Image, Imu
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray
 
-from iemd_ros.conversions import box_to_bbox, fill_bbox, fill_image_msg, ns_to_stamp
+from iemd_ros.conversions import array_to_compressed_fields, box_to_bbox, fill_bbox, fill_image_msg, ns_to_stamp
 
 FRAME_ID = "synthetic_cam"
 
@@ -84,11 +84,16 @@ class Driver:
     """Test node: publishes image/imu/camera_info, ~/init; calls ~/reset and set_parameters;
     records detections and diagnostics of the tracker node ``tracker``."""
 
-    def __init__(self, context, tracker: str = "iemd_tracker", image_topic: str = "image", reliable: bool = True):
+    def __init__(self, context, tracker: str = "iemd_tracker", image_topic: str = "image", reliable: bool = True,
+                 compressed: str | None = None):
+        """``compressed`` ("png" or "jpeg"): publish the frames as CompressedImage on ``<image_topic>/compressed``."""
         self.node = rclpy.create_node("iemd_test_driver", context=context)
         rel = QoSReliabilityPolicy.RELIABLE if reliable else QoSReliabilityPolicy.BEST_EFFORT
         n = self.node
-        self.image_pub = n.create_publisher(Image, image_topic, QoSProfile(depth=10, reliability=rel))
+        self.compressed = compressed
+        image_qos = QoSProfile(depth=10, reliability=rel)
+        self.image_pub = (n.create_publisher(CompressedImage, f"{image_topic}/compressed", image_qos) if compressed
+                          else n.create_publisher(Image, image_topic, image_qos))
         self.imu_pub = n.create_publisher(Imu, "imu", QoSProfile(depth=200, reliability=rel))
         self.info_pub = n.create_publisher(CameraInfo, "camera_info", QoSProfile(depth=10, reliability=rel))
         self.init_pub = n.create_publisher(Detection2D, f"/{tracker}/init", 10)
@@ -129,7 +134,8 @@ class Driver:
 
     # ---------------------------------------------------------------- publishing
     def publish_image(self, frame, t_ns: int, **override) -> None:
-        msg = fill_image_msg(Image(), frame)
+        msg = (CompressedImage(**array_to_compressed_fields(frame, self.compressed)) if self.compressed
+               else fill_image_msg(Image(), frame))
         stamp_header(msg.header, t_ns)
         for name, value in override.items():     # a malformed message on purpose
             setattr(msg, name, value)

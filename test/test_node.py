@@ -31,10 +31,11 @@ def seq():
 
 
 @contextmanager
-def tracker_and_driver(ctx, **params):
+def tracker_and_driver(ctx, compressed: str | None = None, **params):
+    """The tracker node with parameters ``params`` and a driver (publishing ``compressed`` images if given)."""
     overrides = {"diagnostics_period_s": 0.1, "reliable_qos": True, "gyro.time_offset_ns": 4_000_000, **params}
     node = TrackerNode(context=ctx, parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()])
-    driver = Driver(ctx)
+    driver = Driver(ctx, compressed=compressed)
     try:
         with spinning(ctx, node, driver.node):
             assert driver.wait_connected(), "driver and tracker did not discover each other within 10 s"
@@ -224,6 +225,46 @@ def test_malformed_input_keeps_the_node_alive_and_explains(ctx, seq):
         drv.publish_image(seq.frames[3], s[3])
         assert drv.wait_for(lambda: any(stamp_ns(d.header) == s[3] and d.detections for d in drv.detections), 10)
         assert node.context.ok() and node._worker.is_alive()
+
+
+def _track_one_by_one(ctx, seq, n: int, compressed: str | None = None, **params) -> list:
+    """Boxes (center x, y, size x, y) of frames 0..n-1 fed one at a time (each answered before the next)
+    with the gyro and camera_info, from ``initial_box``."""
+    s = [int(v) for v in seq.frame_stamps_ns]
+    box0 = [float(v) for v in seq.gt_boxes[0]]
+    with tracker_and_driver(ctx, compressed, initial_box=box0, imu_wait_ms=500.0, **params) as (node, drv):
+        drv.publish_camera_info(seq)
+        sent = 0
+        for k in range(n):
+            sent = drv.publish_imu_until(seq, s[k], sent)
+            drv.publish_image(seq.frames[k], s[k])
+            assert drv.wait_for(lambda: any(stamp_ns(d.header) == s[k] for d in drv.detections), 10), k
+        return [_boxes(a)[0][:4] for a in drv.detections if a.detections]
+
+
+def test_compressed_transport_tracks_as_raw_images_do(ctx, seq):
+    """image_transport "compressed": CompressedImage on <image>/compressed.  PNG is lossless, so the
+    detections equal those of the raw Image run bit for bit."""
+    raw = _track_one_by_one(ctx, seq, 8)
+    png = _track_one_by_one(ctx, seq, 8, compressed="png", image_transport="compressed")
+    assert len(raw) == 8 and png == raw
+    s = [int(v) for v in seq.frame_stamps_ns]
+    with tracker_and_driver(ctx, "jpeg", image_transport="compressed", initial_box=[float(v) for v in seq.gt_boxes[0]],
+                            imu_wait_ms=0.0) as (node, drv):
+        drv.publish_image(seq.frames[0], s[0])
+        assert drv.wait_for(lambda: any(stamp_ns(d.header) == s[0] and d.detections for d in drv.detections), 10)
+        drv.publish_image(seq.frames[1], s[1], data=b"\xff\xd8 truncated")       # does not decode
+        st = drv.wait_status("image input", lambda x: level(x) == ERROR)
+        assert st is not None and "cannot decode the compressed image" in st.message
+        assert values(st)["topic"] == "/image/compressed"
+        drv.publish_image(seq.frames[2], s[2])                                    # still alive: tracked
+        assert drv.wait_for(lambda: any(stamp_ns(d.header) == s[2] and d.detections for d in drv.detections), 10)
+        assert node._worker.is_alive()
+
+
+def test_unknown_image_transport_is_refused(ctx):
+    with pytest.raises(ValueError, match="image_transport must be 'raw' or 'compressed', got 'theora'"):
+        TrackerNode(context=ctx, parameter_overrides=[Parameter("image_transport", value="theora")])
 
 
 def test_imu_wakes_the_worker_only_for_the_frame_it_holds(ctx, seq):
