@@ -135,9 +135,10 @@ class PipelineConfig:
     def from_yaml(cls, path) -> "PipelineConfig":
         """From a YAML file: either ``{tracker: {...}, gyro: {...}, use_gyro: ..., imu_wait_ms: ...}``
         (:meth:`from_dict`) or the node's ROS parameter file (``config/tracker.yaml``:
-        ``<node>: ros__parameters: ...``), of which the pipeline's keys are used (node-only parameters
-        such as ``initial_box``, ``class_id`` or ``reliable_qos`` are ignored).  ValueError for a file
-        that cannot be read or holds invalid values."""
+        ``<node>: ros__parameters: ...``, nested ``tracker: {n_iter: 10}`` or dotted ``tracker.n_iter: 10``
+        as ROS accepts both), of which the pipeline's keys are used (node-only parameters such as
+        ``initial_box``, ``class_id`` or ``reliable_qos`` are ignored).  ValueError for a file that
+        cannot be read or holds invalid values."""
         import yaml  # noqa: PLC0415 - only the command-line tools read configuration files
 
         path = Path(path)
@@ -151,8 +152,17 @@ class PipelineConfig:
         if ros:
             if len(ros) > 1:
                 raise ValueError(f"config {path} holds parameters of {len(ros)} nodes; keep the tracker's only")
+            nested: dict = {}
+            for key, value in (ros[0] or {}).items():
+                group, _, name = str(key).partition(".")
+                if name:
+                    nested.setdefault(group, {})[name] = value
+                elif isinstance(value, dict):
+                    nested.setdefault(group, {}).update(value)
+                else:
+                    nested[group] = value
             keys = {f.name for f in fields(cls)}
-            values = {k: v for k, v in (ros[0] or {}).items() if k in keys}
+            values = {k: v for k, v in nested.items() if k in keys}
         return cls.from_dict(values)
 
     def to_dict(self) -> dict:

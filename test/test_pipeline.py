@@ -257,3 +257,24 @@ def test_frame_result_is_init_marks_the_init_frame(seq):
     assert p.init(seq.frames[0], seq.gt_boxes[0], s[0]).is_init
     assert not p.process(seq.frames[1], s[1]).is_init
     assert not FrameResult(5, "tracking", reason=INIT_REASON).is_init   # a flag set by init(), not read from the text
+
+
+def test_config_from_yaml_reads_the_node_parameter_file_nested_or_dotted(tmp_path):
+    """A ROS parameter file may write ``tracker: {n_iter: 10}`` or ``tracker.n_iter: 10``: the same config."""
+    nested = "iemd_tracker:\n  ros__parameters:\n    use_gyro: false\n    class_id: car\n" \
+             "    tracker:\n      n_iter: 10\n    gyro:\n      bias: [0.1, 0.0, 0.0]\n"
+    dotted = "iemd_tracker:\n  ros__parameters:\n    use_gyro: false\n    class_id: car\n" \
+             "    tracker.n_iter: 10\n    gyro.bias: [0.1, 0.0, 0.0]\n"
+    plain = "tracker: {n_iter: 10}\ngyro: {bias: [0.1, 0.0, 0.0]}\nuse_gyro: false\n"
+    configs = []
+    for name, text in (("nested", nested), ("dotted", dotted), ("plain", plain)):
+        (tmp_path / f"{name}.yaml").write_text(text)
+        configs.append(PipelineConfig.from_yaml(tmp_path / f"{name}.yaml"))
+    assert configs[0].to_dict() == configs[1].to_dict() == configs[2].to_dict()
+    assert configs[0].tracker.n_iter == 10 and not configs[0].use_gyro and configs[0].gyro.bias[0] == 0.1
+    for text, match in [("iemd_tracker:\n  ros__parameters:\n    tracker.n_iters: 10\n", "unknown tracker parameters"),
+                        ("a:\n  ros__parameters: {}\nb:\n  ros__parameters: {}\n", "parameters of 2 nodes"),
+                        ("- 1\n- 2\n", "must be a mapping"), ("tracker: [\n", "cannot read config")]:
+        (tmp_path / "bad.yaml").write_text(text)
+        with pytest.raises(ValueError, match=match):
+            PipelineConfig.from_yaml(tmp_path / "bad.yaml")
