@@ -9,7 +9,11 @@
   (a ``ValueError``) with a readable message, including truncation found while reading
   (:func:`iter_messages`).
 * :func:`select_topics`: the image / IMU / camera-info topics, auto-detected when a bag has exactly one
-  topic of a type, else named (wrong type or ambiguity -> BagError).
+  topic of a type, else named (wrong type or ambiguity -> BagError).  The image topic is a
+  ``sensor_msgs/Image`` or a ``sensor_msgs/CompressedImage`` (image_transport's ``.../compressed``);
+  auto-detection prefers raw: one Image topic is taken even beside a compressed one (the usual
+  ``image_raw`` + ``image_raw/compressed`` pair carries the same frames, raw is lossless); a bag without
+  an Image topic gives its one CompressedImage topic.  Several topics of the preferred kind -> BagError.
 """
 from __future__ import annotations
 
@@ -24,12 +28,16 @@ import numpy as np
 from .conversions import ns_to_stamp
 from .cli import one_line
 
-__all__ = ["IMAGE_TYPE", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE", "DIAGNOSTICS_TYPE", "FORMATS",
+__all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE",
+           "DIAGNOSTICS_TYPE", "FORMATS",
            "BagError", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize",
            "header", "iter_messages", "open_bag", "resolve_bag_path", "ros1_typestore", "ros2_typestore",
            "select_topics"]
 
 IMAGE_TYPE = "sensor_msgs/msg/Image"
+COMPRESSED_IMAGE_TYPE = "sensor_msgs/msg/CompressedImage"
+#: types an image topic may have, in the order auto-detection prefers them (raw is lossless)
+IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
 IMU_TYPE = "sensor_msgs/msg/Imu"
 CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
 DETECTIONS_TYPE = "vision_msgs/msg/Detection2DArray"
@@ -223,21 +231,25 @@ class Topics:
     camera_info: str | None
 
 
-def _pick(topics: dict, msgtype: str, wanted: str | None, role: str, required: bool) -> str | None:
-    by_type = sorted(t for t, info in topics.items() if info.msgtype == msgtype)
+def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str, required: bool) -> str | None:
+    """The ``role`` topic: ``wanted`` if given (of one of ``msgtypes``), else the one topic of the first
+    type in ``msgtypes`` that the bag has; None (or BagError if ``required``) when it has none."""
+    expected = " or ".join(msgtypes)
     if wanted is not None:
         if wanted not in topics:
             raise BagError(f"{role} topic {wanted!r} is not in the bag (topics: {', '.join(sorted(topics)) or 'none'})")
-        if topics[wanted].msgtype != msgtype:
-            raise BagError(f"{role} topic {wanted!r} has type {topics[wanted].msgtype}, expected {msgtype}")
+        if topics[wanted].msgtype not in msgtypes:
+            raise BagError(f"{role} topic {wanted!r} has type {topics[wanted].msgtype}, expected {expected}")
         return wanted
-    if len(by_type) == 1:
-        return by_type[0]
-    if len(by_type) > 1:
-        flag = {"image": "--image-topic", "IMU": "--imu-topic", "camera-info": "--camera-info-topic"}[role]
-        raise BagError(f"the bag has {len(by_type)} {msgtype} topics ({', '.join(by_type)}); choose one with {flag}")
+    for msgtype in msgtypes:
+        by_type = sorted(t for t, info in topics.items() if info.msgtype == msgtype)
+        if len(by_type) == 1:
+            return by_type[0]
+        if len(by_type) > 1:
+            flag = {"image": "--image-topic", "IMU": "--imu-topic", "camera-info": "--camera-info-topic"}[role]
+            raise BagError(f"the bag has {len(by_type)} {msgtype} topics ({', '.join(by_type)}); choose one with {flag}")
     if required:
-        raise BagError(f"the bag has no {msgtype} topic (topics: "
+        raise BagError(f"the bag has no {expected} topic (topics: "
                        f"{', '.join(f'{t} [{i.msgtype}]' for t, i in sorted(topics.items())) or 'none'})")
     return None
 
@@ -246,11 +258,11 @@ def select_topics(reader, image: str | None = None, imu: str | None = None,
                   camera_info: str | None = None) -> Topics:
     """Choose the image, IMU and camera-info topics of an open reader (see module docstring)."""
     topics = reader.topics
-    img = _pick(topics, IMAGE_TYPE, image, "image", True)
+    img = _pick(topics, IMAGE_TYPES, image, "image", True)
     if topics[img].msgcount == 0:
         raise BagError(f"image topic {img!r} holds no message")
-    return Topics(img, _pick(topics, IMU_TYPE, imu, "IMU", False),
-                  _pick(topics, CAMERA_INFO_TYPE, camera_info, "camera-info", False))
+    return Topics(img, _pick(topics, (IMU_TYPE,), imu, "IMU", False),
+                  _pick(topics, (CAMERA_INFO_TYPE,), camera_info, "camera-info", False))
 
 
 def custom_data(reader) -> dict:
