@@ -10,6 +10,11 @@ Sources (detected from the folder; loaded by :mod:`iemd_ros.recordings` / :mod:`
   line), optionally ``--imu-csv FILE`` (``t_s, wx, wy, wz[, ax, ay, az]``, rad/s, m/s^2) and
   ``--camera-yaml FILE`` (ROS camera_info YAML).
 
+Images are ``sensor_msgs/Image`` (``--encoding`` bgr8 or mono8) on ``--image-topic``, or with
+``--compress jpeg|png`` ``sensor_msgs/CompressedImage`` as image_transport's compressed plugin writes
+them: on ``--image-topic`` + ``/compressed``, format ``"bgr8; jpeg compressed bgr8"`` (mono8:
+``"mono8; png compressed mono8"``), JPEG quality ``--jpeg-quality`` (default 95), PNG level 3 (lossless).
+
 Stamps and clocks (the choice made here)
 ----------------------------------------
 All header stamps are on the **camera clock**: ``Image.header.stamp = CameraInfo.header.stamp`` = the
@@ -47,20 +52,23 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from .bag_io import (CAMERA_INFO_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX, BagWriter, Progress,
-                     camera_info_fields, header)
+from .bag_io import (CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX,
+                     BagWriter, Progress, camera_info_fields, header)
 from .camera import CameraModel
 from .cli import CliParser, cli_main
 from .otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
 from .recordings import seconds_to_ns, load_recording
 
 __all__ = ["BagSource", "source_from_folder", "source_from_synthetic", "write_bag", "main",
-           "DEFAULT_TOPICS", "ENCODINGS"]
+           "DEFAULT_TOPICS", "ENCODINGS", "COMPRESSIONS"]
 
 DEFAULT_TOPICS = dict(image="/camera/image_raw", camera_info="/camera/camera_info", imu="/imu/data")
 CAMERA_FRAME = "camera_optical_frame"
 IMU_FRAME = "imu_link"
 ENCODINGS = ("bgr8", "mono8")
+COMPRESSIONS = ("jpeg", "png")
+JPEG_QUALITY = 95   # image_transport's compressed plugin defaults: jpeg_quality 95, png_level 3
+PNG_LEVEL = 3
 _BASE_NS = 1_000_000_000   # stamps of frame-rate-only sources start at 1 s (0 often means "unset")
 
 
@@ -198,6 +206,19 @@ def _image_msg(bag: BagWriter, topic: str, t: int, frame_id: str, img: np.ndarra
                                is_bigendian=0, step=w * ch, data=img.reshape(-1))
 
 
+def _compressed_msg(bag: BagWriter, topic: str, t: int, frame_id: str, img: np.ndarray, encoding: str,
+                    codec: str, jpeg_quality: int = JPEG_QUALITY):
+    """``img`` as image_transport's compressed plugin publishes it (``cv2.imencode``; format
+    ``"<encoding>; <codec> compressed <encoding>"``)."""
+    param = (cv2.IMWRITE_JPEG_QUALITY, int(jpeg_quality)) if codec == "jpeg" else \
+        (cv2.IMWRITE_PNG_COMPRESSION, PNG_LEVEL)
+    ok, buf = cv2.imencode(f".{codec}", img, param)
+    if not ok:
+        raise ValueError(f"cannot encode a {encoding} frame of shape {img.shape} as {codec}")
+    return bag.msg(COMPRESSED_IMAGE_TYPE)(header=header(bag, topic, t, frame_id),
+                                          format=f"{encoding}; {codec} compressed {encoding}", data=buf.reshape(-1))
+
+
 def _camera_info_msg(bag: BagWriter, topic: str, t: int, frame_id: str, camera: CameraModel, w: int, h: int):
     info = camera.to_camera_info()
     roi = bag.msg("sensor_msgs/msg/RegionOfInterest")(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
@@ -243,13 +264,22 @@ def _schedule(frame_t: np.ndarray, imu_t: np.ndarray | None, with_info: bool) ->
 
 def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8", first: int = 0,
               count: int | None = None, imu_margin_s: float = 0.5, topics: dict | None = None,
-              frame_id: str = CAMERA_FRAME, gt_out=None, progress: Callable[[int], None] | None = None) -> dict:
+              frame_id: str = CAMERA_FRAME, gt_out=None, progress: Callable[[int], None] | None = None,
+              compress: str | None = None, jpeg_quality: int | None = None) -> dict:
     """Write frames ``first .. first+count-1`` of ``source`` (with camera info and the IMU samples
     within ``imu_margin_s`` of them) into a new bag ``out``.  Returns a summary dict (message counts,
-    the IMU shift applied, the frame range).  ``gt_out``: also write the frames' ground truth there
-    (OTB text, 1-based; the desk flags kept as a 5th column)."""
+    the image topic, the IMU shift applied, the frame range).  ``gt_out``: also write the frames' ground
+    truth there (OTB text, 1-based; the desk flags kept as a 5th column).  ``compress`` ``"jpeg"`` /
+    ``"png"``: CompressedImage on the image topic + ``/compressed`` (module docstring)."""
     if encoding not in ENCODINGS:
         raise ValueError(f"encoding must be one of {', '.join(ENCODINGS)}, got {encoding!r}")
+    if compress is not None and compress not in COMPRESSIONS:
+        raise ValueError(f"--compress must be one of {', '.join(COMPRESSIONS)}, got {compress!r}")
+    if jpeg_quality is not None and compress != "jpeg":
+        raise ValueError(f"--jpeg-quality applies to --compress jpeg only (got --compress {compress or 'off'})")
+    quality = JPEG_QUALITY if jpeg_quality is None else jpeg_quality
+    if not 1 <= quality <= 100:
+        raise ValueError(f"--jpeg-quality must be in 1..100, got {quality}")
     n = len(source)
     if not 0 <= first < n:
         raise ValueError(f"--first {first} is outside the {n} frames of {source.name}")
@@ -261,6 +291,11 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
     if gt_out is not None and source.gt_boxes is None:
         raise ValueError(f"{source.name} has no ground truth to write to {gt_out}")
     tp = dict(DEFAULT_TOPICS, **(topics or {}))
+    if compress is not None:
+        if tp["image"].rstrip("/").endswith("/compressed"):
+            raise ValueError(f"--image-topic {tp['image']} ends in /compressed: give the raw topic, --compress "
+                             "appends /compressed as image_transport does")
+        tp["image"] = tp["image"].rstrip("/") + "/compressed"
     frame_t = np.asarray(source.frame_stamps_ns[first:last], dtype=np.int64)
     shift = -int(source.time_offset_ns)                    # IMU clock -> camera clock
     imu_idx = imu_t = None
@@ -282,7 +317,7 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
             f"{META_PREFIX}stamps": "header stamps on the camera clock; IMU already shifted (replay t_d = 0)"}
     imu_frame = source.imu_frame_id or frame_id
     with BagWriter(out, fmt, meta) as bag:
-        bag.add_topic(tp["image"], IMAGE_TYPE)
+        bag.add_topic(tp["image"], IMAGE_TYPE if compress is None else COMPRESSED_IMAGE_TYPE)
         if source.camera is not None:
             bag.add_topic(tp["camera_info"], CAMERA_INFO_TYPE)
         if imu_t is not None:
@@ -299,13 +334,15 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
                 img = first_img if i == 0 else source.read_frame(first + i, encoding == "mono8")
                 if img.shape[:2] != (h, w):
                     raise ValueError(f"frame {first + i} is {img.shape[1]}x{img.shape[0]}, the first one {w}x{h}")
-                bag.write(tp["image"], log_t, _image_msg(bag, tp["image"], int(frame_t[i]), frame_id, img, encoding))
+                args = (bag, tp["image"], int(frame_t[i]), frame_id, img, encoding)
+                bag.write(tp["image"], log_t, _image_msg(*args) if compress is None
+                          else _compressed_msg(*args, compress, quality))
                 if progress is not None:
                     progress(1)
     if gt_out is not None:
         write_gt(gt_out, source.gt_boxes[first:last],
                  None if source.gt_flags is None else source.gt_flags[first:last])
-    return dict(path=str(out), format=fmt, frames=last - first, first=first, size=(w, h),
+    return dict(path=str(out), format=fmt, frames=last - first, first=first, size=(w, h), image_topic=tp["image"],
                 imu=0 if imu_t is None else len(imu_t), camera_info=source.camera is not None,
                 imu_time_shift_ns=shift if imu_t is not None else 0, counts=dict(bag.counts))
 
@@ -331,6 +368,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("out", type=Path, help="output: rosbag2 folder (mcap/sqlite3) or FILE.bag (--format ros1)")
     p.add_argument("--format", choices=FORMATS, default="mcap", help="bag format (default mcap)")
     p.add_argument("--encoding", choices=ENCODINGS, default="bgr8", help="Image encoding (default bgr8)")
+    p.add_argument("--compress", choices=COMPRESSIONS, default=None,
+                   help="write sensor_msgs/CompressedImage (image_transport format) on IMAGE_TOPIC/compressed "
+                        "instead of raw Image (default: raw)")
+    p.add_argument("--jpeg-quality", type=int, default=None, metavar="Q",
+                   help=f"JPEG quality 1..100 for --compress jpeg (default {JPEG_QUALITY})")
     p.add_argument("--first", type=int, default=0, help="first frame (0-based, default 0)")
     p.add_argument("--count", type=int, default=None, help="number of frames (default: to the end)")
     p.add_argument("--imu-margin", type=float, default=0.5, metavar="S",
@@ -362,11 +404,12 @@ def main(argv: list[str] | None = None) -> int:
         try:
             info = write_bag(src, a.out, a.format, a.encoding, a.first, a.count, a.imu_margin,
                              dict(image=a.image_topic, camera_info=a.camera_info_topic, imu=a.imu_topic),
-                             a.frame_id, a.gt_out, bar.update)
+                             a.frame_id, a.gt_out, bar.update, a.compress, a.jpeg_quality)
         finally:
             bar.close()
         print(f"iemd-make-bag: wrote {info['path']} ({info['format']}): {info['frames']} images "
-              f"{info['size'][0]}x{info['size'][1]} {a.encoding}, {info['imu']} IMU samples "
+              f"{info['size'][0]}x{info['size'][1]} {a.encoding}{f' {a.compress}' if a.compress else ''} on "
+              f"{info['image_topic']}, {info['imu']} IMU samples "
               f"(shifted {info['imu_time_shift_ns'] / 1e6:+.1f} ms onto the camera clock), camera info "
               f"{'yes' if info['camera_info'] else 'no'}" + (f"; ground truth -> {a.gt_out}" if a.gt_out else ""))
         return 0

@@ -1,5 +1,6 @@
 """iemd-make-bag: stamps on the camera clock, IMU shifted by the recording's offset, message contents,
-formats (mcap, sqlite3, ROS 1), sources (synthetic, image folder + CSV, CMU desk, phone, OTB), bad input."""
+formats (mcap, sqlite3, ROS 1), compressed images (--compress jpeg/png), sources (synthetic, image folder
++ CSV, CMU desk, phone, OTB), bad input."""
 from pathlib import Path
 
 import cv2
@@ -10,6 +11,7 @@ from helpers import REPO, cli_error, run_module
 
 from iemd_ros.bag_io import custom_data, open_bag
 from iemd_ros.bag_make import main, source_from_folder, write_bag
+from iemd_ros.conversions import image_from_msg
 from iemd_ros.otb import load_sequence, parse_groundtruth
 from iemd_ros.recordings import load_recording
 
@@ -19,9 +21,13 @@ def seq():
     return shaky_sequence(8)
 
 
-def _check_synthetic_bag(path, seq, encoding="bgr8"):
+JPEG_MEAN_ERROR = 4.0   # grey levels; measured at quality 95 on these frames: 3.0 (bgr8), 0.5 (mono8)
+
+
+def _check_synthetic_bag(path, seq, encoding="bgr8", compress=None):
     msgs = read_all(path)
-    imgs, infos, imus = by_topic(msgs, IMG), by_topic(msgs, INFO), by_topic(msgs, IMU)
+    img_topic = IMG + "/compressed" if compress else IMG
+    imgs, infos, imus = by_topic(msgs, img_topic), by_topic(msgs, INFO), by_topic(msgs, IMU)
     assert len(imgs) == len(infos) == len(seq.frames)
     np.testing.assert_array_equal(stamps(imgs), seq.frame_stamps_ns)      # camera clock
     np.testing.assert_array_equal(stamps(infos), seq.frame_stamps_ns)
@@ -34,8 +40,17 @@ def _check_synthetic_bag(path, seq, encoding="bgr8"):
     assert all(m.angular_velocity_covariance[0] == 0 and m.orientation_covariance[0] == -1 for m in imus)
     assert all(m.linear_acceleration_covariance[0] == -1 for m in imus)      # no accelerometer
     for k, m in enumerate(imgs):
-        assert m.encoding == encoding and (m.height, m.width) == seq.frames[k].shape[:2]
         want = seq.frames[k] if encoding == "bgr8" else cv2.cvtColor(seq.frames[k], cv2.COLOR_BGR2GRAY)
+        if compress:        # image_transport's format string; PNG lossless, JPEG close
+            assert m.format == f"{encoding}; {compress} compressed {encoding}"
+            got = image_from_msg(m)
+            assert got.shape == want.shape
+            if compress == "png":
+                np.testing.assert_array_equal(got, want)
+            else:
+                assert np.abs(got.astype(int) - want).mean() < JPEG_MEAN_ERROR
+            continue
+        assert m.encoding == encoding and (m.height, m.width) == seq.frames[k].shape[:2]
         np.testing.assert_array_equal(m.data.reshape(want.shape), want)
         assert m.step == want.shape[1] * (3 if encoding == "bgr8" else 1)
     k_field = infos[0].k if hasattr(infos[0], "k") else infos[0].K
@@ -43,7 +58,8 @@ def _check_synthetic_bag(path, seq, encoding="bgr8"):
     # log times strictly increase; images/infos are logged at their stamp (+ns tie-breaks)
     log = np.array([t for _, _, t, _ in msgs])
     assert np.all(np.diff(log) > 0)
-    img_log = np.array([t for topic, _, t, _ in msgs if topic == IMG])
+    assert {t for t, _, _, _ in msgs} == {img_topic, INFO, IMU}
+    img_log = np.array([t for topic, _, t, _ in msgs if topic == img_topic])
     assert np.all((img_log - seq.frame_stamps_ns >= 0) & (img_log - seq.frame_stamps_ns < 1000))
     return msgs
 
@@ -61,6 +77,17 @@ def test_synthetic_bag_formats(seq, tmp_path, fmt, name):
         reader.close()
         assert meta["iemd_ros.imu_time_shift_ns"] == str(-seq.time_offset_ns)
         assert (tmp_path / name / "metadata.yaml").is_file()
+
+
+@pytest.mark.parametrize("fmt,name,compress,encoding", [
+    ("mcap", "c", "png", "bgr8"), ("sqlite3", "c", "jpeg", "mono8"), ("ros1", "c.bag", "jpeg", "bgr8"),
+    ("ros1", "c.bag", "png", "mono8")])
+def test_compressed_bags(seq, tmp_path, fmt, name, compress, encoding):
+    """--compress: CompressedImage on IMAGE_TOPIC/compressed, camera info and IMU as in a raw bag."""
+    info = make_bag(seq, tmp_path / name, fmt, encoding=encoding, compress=compress)
+    assert info["image_topic"] == IMG + "/compressed" and info["counts"][IMG + "/compressed"] == 8
+    msgs = _check_synthetic_bag(tmp_path / name, seq, encoding, compress)
+    assert {t: ty for t, ty, _, _ in msgs}[IMG + "/compressed"] == "sensor_msgs/msg/CompressedImage"
 
 
 def test_mono8_and_excerpt(seq, tmp_path):
@@ -170,9 +197,37 @@ def test_bad_input(seq, tmp_path, capsys):
     for argv, text in [([str(folder), str(tmp_path / "exists")], "exists already"),
                        ([str(folder), str(tmp_path / "o4"), "--count", "5"], "exceeds the 3 frames"),
                        ([str(folder), str(tmp_path / "o5"), "--format", "ros1"], "must be a file ending in .bag"),
-                       ([str(folder), str(tmp_path / "o6"), "--imu-csv", str(tmp_path / "none.csv")], "cannot read IMU")]:
+                       ([str(folder), str(tmp_path / "o6"), "--imu-csv", str(tmp_path / "none.csv")], "cannot read IMU"),
+                       ([str(folder), str(tmp_path / "o7"), "--compress", "gif"], "invalid choice: 'gif'"),
+                       ([str(folder), str(tmp_path / "o8"), "--jpeg-quality", "80"],
+                        "--jpeg-quality applies to --compress jpeg only (got --compress off)"),
+                       ([str(folder), str(tmp_path / "o9"), "--compress", "png", "--jpeg-quality", "80"],
+                        "--jpeg-quality applies to --compress jpeg only (got --compress png)"),
+                       ([str(folder), str(tmp_path / "o10"), "--compress", "jpeg", "--jpeg-quality", "0"],
+                        "--jpeg-quality must be in 1..100, got 0"),
+                       ([str(folder), str(tmp_path / "o11"), "--compress", "jpeg", "--image-topic",
+                         "/c/image/compressed"], "ends in /compressed: give the raw topic")]:
         assert text in cli_error(main, argv, capsys)
-    assert not (tmp_path / "o4").exists() and not (tmp_path / "o6").exists()   # no partial output
+    assert not any((tmp_path / f"o{k}").exists() for k in range(4, 12))        # no partial output
+
+
+def test_cli_compress_and_quality(seq, tmp_path, capsys):
+    """--compress jpeg --jpeg-quality: lower quality, smaller frames; the summary names topic and codec."""
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in range(3):
+        cv2.imwrite(str(folder / f"{k}.png"), seq.frames[k])
+    sizes = {}
+    for q in ("95", "50"):
+        assert main([str(folder), str(tmp_path / f"q{q}"), "--compress", "jpeg", "--jpeg-quality", q,
+                     "--image-topic", "/cam/image_raw"]) == 0
+        assert "3 images 320x240 bgr8 jpeg on /cam/image_raw/compressed" in capsys.readouterr().out
+        msgs = by_topic(read_all(tmp_path / f"q{q}"), "/cam/image_raw/compressed")
+        assert [m.format for m in msgs] == ["bgr8; jpeg compressed bgr8"] * 3
+        sizes[q] = sum(len(m.data) for m in msgs)
+    assert main([str(folder), str(tmp_path / "qd"), "--compress", "jpeg", "--image-topic", "/cam/image_raw"]) == 0
+    assert sum(len(m.data) for m in by_topic(read_all(tmp_path / "qd"), "/cam/image_raw/compressed")) == sizes["95"]
+    assert sizes["50"] < 0.5 * sizes["95"]
 
 
 def test_cli_process(tmp_path):
