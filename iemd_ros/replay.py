@@ -5,10 +5,12 @@
                 [--camera-yaml FILE] [--time-offset-ms MS] [--progress | --no-progress]
 
 ``BAG``: a rosbag2 folder (sqlite3 or mcap) or a ROS 1 ``.bag`` file (rosbags' AnyReader).  The image,
-IMU and camera-info topics are auto-detected when the bag has one of each type, else named.  The
-messages go, in the bag's (log-time) order, through :class:`iemd_ros.pipeline.TrackingPipeline` -- the
-same synchronization, gyro prediction and tracker as the node -- deterministically: nothing depends on
-the wall clock, so the same bag gives the same CSV byte for byte.
+IMU and camera-info topics are auto-detected when the bag has one of each type, else named.  Images are
+``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage`` (jpeg/png, e.g. ``image_raw/compressed``); a raw
+topic is preferred over a compressed one (:func:`iemd_ros.bag_io.select_topics`).  The messages go, in
+the bag's (log-time) order, through :class:`iemd_ros.pipeline.TrackingPipeline` -- the same
+synchronization, gyro prediction and tracker as the node -- deterministically: nothing depends on the
+wall clock, so the same bag gives the same CSV byte for byte.
 
 IMU synchronization: a frame is held until the gyro covers it (:meth:`TrackingPipeline.gyro_ready`)
 or until ``imu_wait_ms`` (pipeline config, default 15 ms) of *bag* time has passed after it (a message
@@ -25,7 +27,8 @@ can be decoded, as the node does with its ``initial_box``.
 
 Outputs: the CSV (``stamp_ns,x,y,w,h,emd,state``, one row per image, floats in shortest round-trip
 form; the init frame's row holds the init box with state ``init`` and an empty emd; a frame the
-pipeline could not use has an empty box and state ``rejected``/``malformed``); optionally a rosbag2 (mcap) with
+pipeline could not use has an empty box and state ``rejected``/``malformed`` (an image that does not
+convert or decode: counted, tracking goes on)); optionally a rosbag2 (mcap) with
 ``vision_msgs/Detection2DArray`` and ``diagnostic_msgs/DiagnosticArray`` stamped and logged like the
 images (open it in Foxglove next to the input), an annotated MP4 (``mp4v``), and with ``--gt`` (OTB
 ``x,y,w,h`` or the desk ``x,y,w,h,flag`` format, one line per image, 1-based) the metrics of
@@ -412,7 +415,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("bag", help="rosbag2 folder (sqlite3/mcap) or ROS 1 .bag file")
     p.add_argument("--init", required=True, type=str, metavar="X,Y,W,H",
                    help="initial box on the first image (0-based pixels, top-left + size)")
-    p.add_argument("--image-topic", default=None)
+    p.add_argument("--image-topic", default=None, help="sensor_msgs/Image or CompressedImage topic "
+                                                        "(default: the bag's one raw, else its one compressed)")
     p.add_argument("--imu-topic", default=None)
     p.add_argument("--camera-info-topic", default=None)
     p.add_argument("--no-gyro", action="store_true", help="track without the gyro prior")
