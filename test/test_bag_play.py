@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 import pytest
-from bag_fixtures import IMG, IMU, INFO, make_bag, shaky_sequence
+from bag_fixtures import IMG, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence
 from helpers import cli_error, detection_box
 
 rclpy = pytest.importorskip("rclpy")
@@ -23,7 +23,7 @@ pytest.importorskip("vision_msgs.msg")
 from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy  # noqa: E402
 from ros_harness import spinning  # noqa: E402
-from sensor_msgs.msg import CameraInfo, Image, Imu  # noqa: E402
+from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu  # noqa: E402
 from vision_msgs.msg import Detection2DArray  # noqa: E402
 
 from iemd_ros.bag_make import source_from_folder, write_bag  # noqa: E402
@@ -46,11 +46,13 @@ class Recorder:
     def __init__(self, context):
         self.node = rclpy.create_node("iemd_test_recorder", context=context)
         self.lock = threading.Lock()
-        self.got = {"img": [], "imu": [], "info": [], "det": []}
+        self.got = {"img": [], "compressed": [], "imu": [], "info": [], "det": []}
         q = QoSProfile(depth=1000, reliability=QoSReliabilityPolicy.RELIABLE)
         n = self.node
         n.create_subscription(Image, IMG, lambda m: self._add("img", (time.monotonic(), stamp_ns(m.header),
                                                                      bytes(m.data), m.encoding)), q)
+        n.create_subscription(CompressedImage, IMG + "/compressed",
+                              lambda m: self._add("compressed", (stamp_ns(m.header), m.format, bytes(m.data))), q)
         n.create_subscription(Imu, IMU, lambda m: self._add("imu", (stamp_ns(m.header), m.angular_velocity.x)), q)
         n.create_subscription(CameraInfo, INFO, lambda m: self._add("info", list(m.k)), q)
         n.create_subscription(Detection2DArray, "/detections", lambda m: self._add("det", m), q)
@@ -96,6 +98,26 @@ def test_play_contents_and_timing(ctx, seq, tmp_path, fmt, name):
     recv = [t for t, _, _, _ in g["img"]]
     expect = (seq.frame_stamps_ns[-1] - seq.frame_stamps_ns[0]) * 1e-9 / 2.0
     assert abs((recv[-1] - recv[0]) - expect) < 0.25
+
+
+@pytest.mark.parametrize("fmt,name", [("mcap", "c"), ("ros1", "c.bag")])
+def test_play_compressed(ctx, seq, tmp_path, fmt, name):
+    """A CompressedImage topic goes out as sensor_msgs/CompressedImage with the bag's stamps, format and
+    bytes (a ROS 1 bag through rosbags' converter)."""
+    make_bag(seq, tmp_path / name, fmt, compress="jpeg", imu_margin_s=0.0)
+    topic = IMG + "/compressed"
+    want = [(stamp_ns(m.header), m.format, bytes(m.data)) for m in by_topic(read_all(tmp_path / name), topic)]
+    rec = Recorder(ctx)
+    player = rclpy.create_node("iemd_test_player", context=ctx)
+    try:
+        with spinning(ctx, rec.node):
+            stats = play(tmp_path / name, rate=4.0, topics=[topic, INFO], wait_subscribers_s=10.0, node=player)
+            assert rec.wait(lambda g: len(g["compressed"]) == len(seq.frames), 10.0)
+    finally:
+        player.destroy_node()
+        rec.node.destroy_node()
+    assert stats.published == {topic: len(seq.frames), INFO: len(seq.frames)} and rec.got["img"] == []
+    assert rec.got["compressed"] == want and want[0][1] == "bgr8; jpeg compressed bgr8"
 
 
 def _live_vs_offline(ctx, bag, init, n_frames):
