@@ -6,13 +6,18 @@ folder, then measures in the same run:
 
 * the bag I/O alone (read + CDR decode + ``image_to_array`` of every message): the replay's floor;
 * the full offline replay (``iemd_ros.replay.replay``: synchronization, gyro prediction, tracker), with
-  the gyro prior and, with ``--no-gyro-too``, without it.
+  the gyro prior and, with ``--no-gyro-too``, without it;
+* with ``--compress jpeg png``: the same frames as ``sensor_msgs/CompressedImage`` bags
+  (``iemd-make-bag --compress``), bag I/O (now with the image decoding) and replay with the gyro, and the
+  mean IoU of each compressed run's boxes against the raw run's.
 
 Printed: bag duration, wall time, the real-time factor (bag time / wall time; > 1 is faster than real
 time), the share of the wall time spent in the tracker's ``update``, the tracker's mean ms/frame, and the
-time of everything else in the replay (its own overhead, which alone must allow >= 3x).
+time of everything else in the replay (its own overhead, which alone must allow >= 3x), and frames per
+second of wall time.
 
-    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py [--frames N] [--no-gyro-too] [--keep DIR]
+    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py [--frames N] [--no-gyro-too] [--compress C ...]
+                                                             [--keep DIR]
 """
 from __future__ import annotations
 
@@ -24,8 +29,9 @@ import time
 from pathlib import Path
 
 from iemd_ros.bag_io import deserialize, iter_messages, open_bag, select_topics
-from iemd_ros.bag_make import source_from_folder, write_bag
+from iemd_ros.bag_make import COMPRESSIONS, source_from_folder, write_bag
 from iemd_ros.conversions import image_from_msg
+from iemd_ros.metrics import iou
 from iemd_ros.replay import replay
 
 DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
@@ -54,35 +60,48 @@ def main() -> int:
     ap.add_argument("--desk", type=Path, default=DESK, help="cmu_hwangbo_desk folder")
     ap.add_argument("--frames", type=int, default=None, help="first N frames only (default: all 825)")
     ap.add_argument("--no-gyro-too", action="store_true", help="also replay without the gyro prior")
-    ap.add_argument("--keep", type=Path, default=None, help="write the bag here and keep it")
+    ap.add_argument("--compress", nargs="+", choices=COMPRESSIONS, default=[],
+                    help="also replay the frames as CompressedImage bags of these codecs")
+    ap.add_argument("--keep", type=Path, default=None, help="write the bags into this folder and keep them")
     a = ap.parse_args()
     if not a.desk.is_dir():
         print(f"replay_speed: the desk recording is not at {a.desk}", file=sys.stderr)
         return 2
     tmp = Path(tempfile.mkdtemp(prefix="iemd_replay_speed_"))
-    bag = a.keep if a.keep is not None else tmp / "desk"
+    folder = a.keep if a.keep is not None else tmp
     try:
         src = source_from_folder(a.desk)
-        t0 = time.perf_counter()
-        info = write_bag(src, bag, "mcap", count=a.frames)
-        t_make = time.perf_counter() - t0
-        print(f"bag: {info['frames']} images {info['size'][0]}x{info['size'][1]} bgr8 + {info['imu']} IMU samples "
-              f"-> {bag} (made in {t_make:.1f} s)")
-        t_io, n = io_only(bag)
+        bags = {}
+        for codec in [None, *a.compress]:
+            bags[codec or "raw"] = bag = folder / f"desk_{codec or 'raw'}"
+            t0 = time.perf_counter()
+            info = write_bag(src, bag, "mcap", count=a.frames, compress=codec)
+            print(f"bag: {info['frames']} images {info['size'][0]}x{info['size'][1]} bgr8 {codec or 'raw'} + "
+                  f"{info['imu']} IMU samples -> {bag} (made in {time.perf_counter() - t0:.1f} s)")
         init = tuple(float(v) for v in src.gt_boxes[0])
-        runs = [("gyro", True)] + ([("no-gyro", False)] if a.no_gyro_too else [])
+        runs = [("raw", "gyro", True)] + ([("raw", "no-gyro", False)] if a.no_gyro_too else []) + \
+               [(codec, "gyro", True) for codec in a.compress]
+        io = {kind: io_only(bag) for kind, bag in bags.items()}
         results = []
-        for label, use in runs:
-            res = replay(bag, init, use_gyro=use, progress=None)
-            results.append((label, res))
+        for kind, label, use in runs:
+            res = replay(bags[kind], init, use_gyro=use, progress=None)
+            results.append((f"{label} {kind}", res))
+        n = io["raw"][1]
         dur = results[0][1].duration_s
         print(f"\nbag duration (images): {dur:.2f} s ({n} frames)\n")
-        print(f"{'run':<16} {'wall s':>8} {'x real time':>12} {'tracker %':>10} {'tracker ms/frame':>17}")
-        print(f"{'bag I/O only':<16} {t_io:8.2f} {dur / t_io:12.2f} {'-':>10} {'-':>17}")
+        print(f"{'run':<20} {'wall s':>8} {'x real time':>12} {'frames/s':>9} {'tracker %':>10} "
+              f"{'tracker ms/frame':>17}")
+        for kind, (t_io, _) in io.items():
+            print(f"{'bag I/O only ' + kind:<20} {t_io:8.2f} {dur / t_io:12.2f} {n / t_io:9.1f} {'-':>10} {'-':>17}")
         for label, res in results:
             per = 1e3 * res.track_s / max(len(res.results) - 1, 1)
-            print(f"{'replay ' + label:<16} {res.wall_s:8.2f} {res.realtime_factor:12.2f} "
-                  f"{100 * res.track_s / res.wall_s:10.1f} {per:17.1f}")
+            print(f"{'replay ' + label:<20} {res.wall_s:8.2f} {res.realtime_factor:12.2f} "
+                  f"{len(res.results) / res.wall_s:9.1f} {100 * res.track_s / res.wall_s:10.1f} {per:17.1f}")
+        for label, res in results[1:]:
+            if not label.endswith("raw"):
+                agree = iou(results[0][1].boxes, res.boxes)[1:]
+                print(f"boxes of replay {label} against replay gyro raw: mean IoU {agree.mean():.4f}, "
+                      f"min {agree.min():.4f}")
         res = results[0][1]
         rf = res.realtime_factor
         rest = res.wall_s - res.track_s - res.init_s
