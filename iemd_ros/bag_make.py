@@ -13,7 +13,7 @@ Sources (detected from the folder; loaded by :mod:`iemd_ros.recordings` / :mod:`
 Images are ``sensor_msgs/Image`` (``--encoding`` bgr8 or mono8) on ``--image-topic``, or with
 ``--compress jpeg|png`` ``sensor_msgs/CompressedImage`` as image_transport's compressed plugin writes
 them: on ``--image-topic`` + ``/compressed``, format ``"bgr8; jpeg compressed bgr8"`` (mono8:
-``"mono8; png compressed mono8"``), JPEG quality ``--jpeg-quality`` (default 95), PNG level 3 (lossless).
+``"mono8; png compressed mono8"``), JPEG quality ``--jpeg-quality`` (default 95); PNG is lossless.
 
 Stamps and clocks (the choice made here)
 ----------------------------------------
@@ -56,6 +56,7 @@ from .bag_io import (CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, FORMATS, IMAGE_TYP
                      BagWriter, Progress, camera_info_fields, header)
 from .camera import CameraModel
 from .cli import CliParser, cli_main
+from .conversions import array_to_compressed_fields
 from .otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
 from .recordings import seconds_to_ns, load_recording
 
@@ -67,8 +68,7 @@ CAMERA_FRAME = "camera_optical_frame"
 IMU_FRAME = "imu_link"
 ENCODINGS = ("bgr8", "mono8")
 COMPRESSIONS = ("jpeg", "png")
-JPEG_QUALITY = 95   # image_transport's compressed plugin defaults: jpeg_quality 95, png_level 3
-PNG_LEVEL = 3
+JPEG_QUALITY = 95   # image_transport's compressed plugin default
 _BASE_NS = 1_000_000_000   # stamps of frame-rate-only sources start at 1 s (0 often means "unset")
 
 
@@ -206,17 +206,13 @@ def _image_msg(bag: BagWriter, topic: str, t: int, frame_id: str, img: np.ndarra
                                is_bigendian=0, step=w * ch, data=img.reshape(-1))
 
 
-def _compressed_msg(bag: BagWriter, topic: str, t: int, frame_id: str, img: np.ndarray, encoding: str,
-                    codec: str, jpeg_quality: int = JPEG_QUALITY):
-    """``img`` as image_transport's compressed plugin publishes it (``cv2.imencode``; format
-    ``"<encoding>; <codec> compressed <encoding>"``)."""
-    param = (cv2.IMWRITE_JPEG_QUALITY, int(jpeg_quality)) if codec == "jpeg" else \
-        (cv2.IMWRITE_PNG_COMPRESSION, PNG_LEVEL)
-    ok, buf = cv2.imencode(f".{codec}", img, param)
-    if not ok:
-        raise ValueError(f"cannot encode a {encoding} frame of shape {img.shape} as {codec}")
-    return bag.msg(COMPRESSED_IMAGE_TYPE)(header=header(bag, topic, t, frame_id),
-                                          format=f"{encoding}; {codec} compressed {encoding}", data=buf.reshape(-1))
+def _compressed_msg(bag: BagWriter, topic: str, t: int, frame_id: str, img: np.ndarray, codec: str,
+                    jpeg_quality: int = JPEG_QUALITY):
+    """``img`` (bgr8 or mono8) as image_transport's compressed plugin publishes it
+    (:func:`iemd_ros.conversions.array_to_compressed_fields`)."""
+    fields = array_to_compressed_fields(img, codec, jpeg_quality)
+    return bag.msg(COMPRESSED_IMAGE_TYPE)(header=header(bag, topic, t, frame_id), format=fields["format"],
+                                          data=np.frombuffer(fields["data"], dtype=np.uint8))
 
 
 def _camera_info_msg(bag: BagWriter, topic: str, t: int, frame_id: str, camera: CameraModel, w: int, h: int):
@@ -278,8 +274,6 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
     if jpeg_quality is not None and compress != "jpeg":
         raise ValueError(f"--jpeg-quality applies to --compress jpeg only (got --compress {compress or 'off'})")
     quality = JPEG_QUALITY if jpeg_quality is None else jpeg_quality
-    if not 1 <= quality <= 100:
-        raise ValueError(f"--jpeg-quality must be in 1..100, got {quality}")
     n = len(source)
     if not 0 <= first < n:
         raise ValueError(f"--first {first} is outside the {n} frames of {source.name}")
@@ -334,8 +328,8 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
                 img = first_img if i == 0 else source.read_frame(first + i, encoding == "mono8")
                 if img.shape[:2] != (h, w):
                     raise ValueError(f"frame {first + i} is {img.shape[1]}x{img.shape[0]}, the first one {w}x{h}")
-                args = (bag, tp["image"], int(frame_t[i]), frame_id, img, encoding)
-                bag.write(tp["image"], log_t, _image_msg(*args) if compress is None
+                args = (bag, tp["image"], int(frame_t[i]), frame_id, img)
+                bag.write(tp["image"], log_t, _image_msg(*args, encoding) if compress is None
                           else _compressed_msg(*args, compress, quality))
                 if progress is not None:
                     progress(1)

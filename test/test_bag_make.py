@@ -204,7 +204,7 @@ def test_bad_input(seq, tmp_path, capsys):
                        ([str(folder), str(tmp_path / "o9"), "--compress", "png", "--jpeg-quality", "80"],
                         "--jpeg-quality applies to --compress jpeg only (got --compress png)"),
                        ([str(folder), str(tmp_path / "o10"), "--compress", "jpeg", "--jpeg-quality", "0"],
-                        "--jpeg-quality must be in 1..100, got 0"),
+                        "JPEG quality must be in [1, 100], got 0"),
                        ([str(folder), str(tmp_path / "o11"), "--compress", "jpeg", "--image-topic",
                          "/c/image/compressed"], "ends in /compressed: give the raw topic")]:
         assert text in cli_error(main, argv, capsys)

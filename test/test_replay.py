@@ -175,7 +175,7 @@ def _bag_with(path, *, image_topics=("/cam/image",), imu=False, bad_at=None, n=4
             f = seq.frames[k]
             for topic in image_topics:
                 if topic.endswith("/compressed"):
-                    msg = _compressed_msg(bag, topic, ts, "cam", f, "bgr8", "png")
+                    msg = _compressed_msg(bag, topic, ts, "cam", f, "png")
                     if k == bad_at:
                         msg.data = msg.data[:len(msg.data) // 2]            # cut off, as by a broken transfer
                 else:
