@@ -67,7 +67,7 @@ def main() -> int:
     if not a.desk.is_dir():
         print(f"replay_speed: the desk recording is not at {a.desk}", file=sys.stderr)
         return 2
-    tmp = Path(tempfile.mkdtemp(prefix="iemd_replay_speed_"))
+    tmp = Path(tempfile.mkdtemp(prefix="iemd_replay_speed_"))     # holds the bags unless --keep
     folder = a.keep if a.keep is not None else tmp
     try:
         src = source_from_folder(a.desk)
@@ -113,8 +113,7 @@ def main() -> int:
               f"update must stay below {max(1e3 * (dur / 3 - rest - res.init_s) / n, 0):.1f} ms/frame")
         return 0
     finally:
-        if a.keep is None:
-            shutil.rmtree(tmp, ignore_errors=True)
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 if __name__ == "__main__":
