@@ -8,7 +8,10 @@ to the arrival of the Detection2DArray carrying its stamp (both on the driver's 
 
 * ``inproc``: tracker node and driver in one process (one DDS participant);
 * ``process``: the tracker as its own process (``python -m iemd_ros.node``), default transport;
-* ``process-shm``: the same with ``config/fastdds_shm.xml`` (FASTRTPS_DEFAULT_PROFILES_FILE) in both.
+* ``process-shm``: the same with ``config/fastdds_shm.xml`` (FASTRTPS_DEFAULT_PROFILES_FILE) in both;
+* ``process-jpeg``: the tracker process with ``image_transport`` "compressed", the frames published as
+  JPEG (quality 95) CompressedImage on ``image/compressed``; its latency includes the decoding
+  (1-2 ms; "track ms" is the tracker alone).
 
 Peer, measured in the same run and setup: an echo node that answers each image with an empty
 Detection2DArray at once (transport + rclpy overhead only).  Frames the tracker drops as stale (it
@@ -39,9 +42,15 @@ def _qos(reliable: bool):
     return QoSProfile(depth=5, reliability=QoSReliabilityPolicy.RELIABLE) if reliable else qos_profile_sensor_data
 
 
-def _add_echo(node, reliable: bool) -> None:
-    """Make ``node`` answer every image with an empty Detection2DArray (header copied)."""
-    from sensor_msgs.msg import Image
+def _compressed(setup: str) -> bool:
+    """Whether the setup sends JPEG CompressedImage on ``image/compressed`` instead of raw images."""
+    return setup.endswith("-jpeg")
+
+
+def _add_echo(node, reliable: bool, compressed: bool = False) -> None:
+    """Make ``node`` answer every image (CompressedImage if ``compressed``, not decoded) with an empty
+    Detection2DArray (header copied)."""
+    from sensor_msgs.msg import CompressedImage, Image
     from vision_msgs.msg import Detection2DArray
 
     pub = node.create_publisher(Detection2DArray, "detections", 10)
@@ -51,10 +60,13 @@ def _add_echo(node, reliable: bool) -> None:
         out.header = msg.header
         pub.publish(out)
 
-    node.create_subscription(Image, "image", on_image, _qos(reliable))
+    if compressed:
+        node.create_subscription(CompressedImage, "image/compressed", on_image, _qos(reliable))
+    else:
+        node.create_subscription(Image, "image", on_image, _qos(reliable))
 
 
-def _echo_main(reliable: bool) -> int:
+def _echo_main(reliable: bool, compressed: bool) -> int:
     """--serve-echo: the echo as its own process."""
     import rclpy
 
@@ -62,7 +74,7 @@ def _echo_main(reliable: bool) -> int:
 
     rclpy.init()
     node = rclpy.create_node("iemd_echo")
-    _add_echo(node, reliable)
+    _add_echo(node, reliable, compressed)
     spin_until_shutdown(node)
     return 0
 
@@ -73,14 +85,16 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.parameter import Parameter
     from rclpy.qos import QoSProfile
-    from sensor_msgs.msg import CameraInfo, Image, Imu
+    from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.conversions import fill_image_msg, ns_to_stamp, stamp_ns
+    from iemd_ros.conversions import array_to_compressed_fields, fill_image_msg, ns_to_stamp, stamp_ns
 
     env = dict(os.environ)             # the caller set FASTRTPS_DEFAULT_PROFILES_FILE for -shm
     box0 = [float(v) for v in seq.gt_boxes[0]]
-    params = {"initial_box": box0, "reliable_qos": args.reliable, "diagnostics_period_s": 0.2}
+    compressed = _compressed(setup)
+    params = {"initial_box": box0, "reliable_qos": args.reliable, "diagnostics_period_s": 0.2,
+              "image_transport": "compressed" if compressed else "raw"}
     context = rclpy.Context()
     rclpy.init(context=context)
     proc = None
@@ -93,7 +107,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
                     Parameter(k, value=v) for k, v in params.items()]))
             else:
                 echo = rclpy.create_node("iemd_echo", context=context)
-                _add_echo(echo, args.reliable)
+                _add_echo(echo, args.reliable, compressed)
                 nodes.append(echo)
         else:
             if subject == "tracker":
@@ -101,12 +115,14 @@ def _run(args, seq, setup: str, subject: str) -> dict:
                 for k, v in params.items():
                     cmd += ["-p", f"{k}:={str(v).lower() if isinstance(v, bool) else v}"]
             else:
-                cmd = [sys.executable, __file__, "--serve-echo"] + (["--reliable"] if args.reliable else [])
+                cmd = ([sys.executable, __file__, "--serve-echo"] + (["--reliable"] if args.reliable else [])
+                       + (["--compressed"] if compressed else []))
             proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
 
         drv = rclpy.create_node("iemd_latency_driver", context=context)
         qos = _qos(args.reliable)
-        img_pub = drv.create_publisher(Image, "image", qos)
+        img_pub = (drv.create_publisher(CompressedImage, "image/compressed", qos) if compressed
+                   else drv.create_publisher(Image, "image", qos))
         imu_pub = drv.create_publisher(Imu, "imu", QoSProfile(depth=200, reliability=qos.reliability))
         info_pub = drv.create_publisher(CameraInfo, "camera_info", qos)
         sent: dict[int, int] = {}
@@ -148,7 +164,8 @@ def _run(args, seq, setup: str, subject: str) -> dict:
         info.distortion_model = "plumb_bob"
         msgs = []
         for k, frame in enumerate(seq.frames):
-            m = fill_image_msg(Image(), frame)
+            m = (CompressedImage(**array_to_compressed_fields(frame, "jpeg")) if compressed
+                 else fill_image_msg(Image(), frame))
             m.header.frame_id = "cam"
             m.header.stamp.sec, m.header.stamp.nanosec = ns_to_stamp(int(seq.frame_stamps_ns[k]))
             msgs.append(m)
@@ -198,14 +215,15 @@ def main(argv=None) -> int:
     ap.add_argument("--rate", type=float, default=30.0)
     ap.add_argument("--width", type=int, default=640)
     ap.add_argument("--height", type=int, default=480)
-    ap.add_argument("--setups", default="inproc,process,process-shm")
+    ap.add_argument("--setups", default="inproc,process,process-shm,process-jpeg")
     ap.add_argument("--subjects", default="echo,tracker")
     ap.add_argument("--reliable", action="store_true", help="reliable QoS instead of sensor-data (best effort)")
     ap.add_argument("--serve-echo", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--compressed", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--measure", nargs=2, metavar=("SETUP", "SUBJECT"), help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.serve_echo:
-        return _echo_main(args.reliable)
+        return _echo_main(args.reliable, args.compressed)
     if args.measure:
         from iemd_ros.synthetic import generate
         seq = generate(n_frames=args.frames, width=args.width, height=args.height, max_rate_deg_s=60.0,
