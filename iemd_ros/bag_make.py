@@ -13,7 +13,7 @@ Sources (detected from the folder; loaded by :mod:`iemd_ros.recordings` / :mod:`
 Images are ``sensor_msgs/Image`` (``--encoding`` bgr8 or mono8) on ``--image-topic``, or with
 ``--compress jpeg|png`` ``sensor_msgs/CompressedImage`` as image_transport's compressed plugin writes
 them: on ``--image-topic`` + ``/compressed``, format ``"bgr8; jpeg compressed bgr8"`` (mono8:
-``"mono8; png compressed mono8"``), JPEG quality ``--jpeg-quality`` (default 95); PNG is lossless.
+``"mono8; png compressed "``), JPEG quality ``--jpeg-quality`` (default 95); PNG is lossless.
 
 Stamps and clocks (the choice made here)
 ----------------------------------------

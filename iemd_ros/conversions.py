@@ -102,7 +102,11 @@ def compressed_to_array(fmt: str, data) -> np.ndarray:
     buf = np.frombuffer(_as_bytes(data), dtype=np.uint8)
     if buf.size == 0:
         raise ValueError(f"compressed image ({fmt!r}) has no data")
-    img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+    try:
+        img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+    except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV accepts
+        raise ValueError(f"cannot decode the compressed image (format {fmt!r}, {buf.size} bytes): "
+                         f"{str(exc).strip().splitlines()[-1]}") from None
     if img is None:
         raise ValueError(f"cannot decode the compressed image (format {fmt!r}, {buf.size} bytes)")
     if img.dtype == np.uint16:
@@ -137,8 +141,9 @@ def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dic
 
 def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: int = 95) -> dict:
     """Tracker frame -> ``sensor_msgs/CompressedImage`` fields as image_transport's compressed plugin
-    writes them: ``format`` ``"bgr8; jpeg compressed bgr8"`` (``mono8`` for ``HxW``; ``png`` is
-    lossless) and the encoded ``data`` as ``bytes``.  ``quality``: JPEG quality, 1-100."""
+    writes them: ``format`` ``"bgr8; jpeg compressed bgr8"``, for ``HxW`` ``"mono8; jpeg compressed "``
+    (the plugin names a target encoding for colour only; ``png`` is lossless) and the encoded ``data``
+    as ``bytes``.  ``quality``: JPEG quality, 1-100."""
     frame = np.asarray(frame)
     if frame.dtype != np.uint8 or frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
         raise ValueError(f"frame must be HxW or HxWx3 uint8, got {frame.dtype} {frame.shape}")
@@ -150,8 +155,8 @@ def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: 
     ok, buf = cv2.imencode(".jpg" if codec == "jpeg" else ".png", frame, params)
     if not ok:
         raise ValueError(f"OpenCV could not encode a {frame.shape} frame as {codec}")
-    encoding = "mono8" if frame.ndim == 2 else "bgr8"
-    return dict(format=f"{encoding}; {codec} compressed {encoding}", data=buf.tobytes())
+    fmt = f"mono8; {codec} compressed " if frame.ndim == 2 else f"bgr8; {codec} compressed bgr8"
+    return dict(format=fmt, data=buf.tobytes())
 
 
 def fill_image_msg(msg, frame: np.ndarray, encoding: str | None = None):

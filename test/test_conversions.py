@@ -186,8 +186,17 @@ def test_compressed_images_decode_to_bgr_frames():
     assert out.shape == blue.shape and out[..., 0].min() > 240 and out[..., 1:].max() < 15
 
 
+def _jpeg_declaring(width: int, height: int) -> bytes:
+    """A small JPEG whose frame header (SOF0) claims ``width`` x ``height`` pixels."""
+    data = bytearray(_encoded(".jpg", np.zeros((8, 8), np.uint8)))
+    sof = data.find(b"\xff\xc0")
+    data[sof + 5:sof + 9] = height.to_bytes(2, "big") + width.to_bytes(2, "big")
+    return bytes(data)
+
+
 @pytest.mark.parametrize("fmt, data, match", [
     ("jpeg", b"", "has no data"),
+    ("jpeg", _jpeg_declaring(65000, 65000), "cannot decode the compressed image .*CV_IO_MAX_IMAGE_PIXELS"),
     ("jpeg", b"\xff\xd8 not really a jpeg", "cannot decode the compressed image"),
     ("16UC1; compressedDepth png", b"\x00" * 16, "depth map"),
 ])
@@ -203,7 +212,7 @@ def test_frames_compress_as_image_transport_writes_them():
     assert png["format"] == "bgr8; png compressed bgr8" and isinstance(png["data"], bytes)
     np.testing.assert_array_equal(compressed_to_array(png["format"], png["data"]), bgr)
     grey = array_to_compressed_fields(bgr[..., 0].copy(), "jpeg", quality=100)
-    assert grey["format"] == "mono8; jpeg compressed mono8"
+    assert grey["format"] == "mono8; jpeg compressed "          # the plugin names no target for grey
     assert np.abs(compressed_to_array(grey["format"], grey["data"]).astype(int) - bgr[..., 0]).mean() < 2.0
     small, large = (len(array_to_compressed_fields(bgr, "jpeg", quality=q)["data"]) for q in (10, 95))
     assert small < large                                                    # the quality is applied
