@@ -89,6 +89,18 @@ def gyro_config_to_dict(cfg: GyroConfig) -> dict:
     return d
 
 
+NODE_NAME = "iemd_tracker"  # the tracker node's default name (iemd_ros.node), as parameter files name it
+
+
+def _parameter_sections(tree: dict, names: tuple = ()):
+    """(node path, its ``ros__parameters``) of every section of a ROS parameter file, namespaces included."""
+    for key, value in tree.items():
+        if key == "ros__parameters":
+            yield "/".join(names), value
+        elif isinstance(value, dict):
+            yield from _parameter_sections(value, names + (str(key),))
+
+
 @dataclass
 class PipelineConfig:
     """Tracker + gyro settings and the pipeline's own.
@@ -118,6 +130,8 @@ class PipelineConfig:
             raise ValueError(f"clock_reset_ms must be > 0, got {self.clock_reset_ms}")
         if not self.score_emd_scale > 0:
             raise ValueError(f"score_emd_scale must be > 0, got {self.score_emd_scale}")
+        if not isinstance(self.use_gyro, (bool, np.bool_)):
+            raise ValueError(f"use_gyro must be true or false, got {self.use_gyro!r}")
         self.use_gyro = bool(self.use_gyro)
 
     @classmethod
@@ -127,43 +141,73 @@ class PipelineConfig:
         unknown = set(v) - {f.name for f in fields(cls)}
         if unknown:
             raise ValueError(f"unknown pipeline parameters: {', '.join(sorted(unknown))}")
-        v["tracker"] = TrackerConfig.from_dict(v.get("tracker", {}))
-        v["gyro"] = gyro_config_from_dict(v.get("gyro", {}))
-        return cls(**v)
+        for group in ("tracker", "gyro"):
+            if not isinstance(v.get(group, {}), dict):
+                raise ValueError(f"{group} must be a mapping of its parameters, got {v[group]!r}")
+        try:
+            v["tracker"] = TrackerConfig.from_dict(v.get("tracker", {}))
+            v["gyro"] = gyro_config_from_dict(v.get("gyro", {}))
+            return cls(**v)
+        except TypeError as exc:  # a value of the wrong type, e.g. text for a number
+            raise ValueError(f"invalid pipeline parameters: {exc}") from None
 
     @classmethod
-    def from_yaml(cls, path) -> "PipelineConfig":
+    def from_parameters(cls, params: dict) -> "PipelineConfig":
+        """From the node's ROS parameters: ``tracker.n_iter`` (dotted, as the node declares them) or a
+        group ``tracker: {n_iter: 10}`` (a parameter file may write either; a later key wins).  Node-only
+        parameters (``initial_box``, ``class_id``, ...) are ignored."""
+        keys = {f.name for f in fields(cls)}
+        values: dict = {"tracker": {}, "gyro": {}}
+        for key, value in params.items():
+            group, dot, name = str(key).partition(".")
+            if group in ("tracker", "gyro"):
+                if dot:
+                    values[group][name] = value
+                elif isinstance(value, dict):
+                    values[group].update(value)
+                else:
+                    raise ValueError(f"{group} must be a group of parameters ({group}.<name>), got {value!r}")
+            elif group in keys:
+                if dot:
+                    raise ValueError(f"{group} is a single parameter, not a group: got {key!r}")
+                values[group] = value
+        return cls.from_dict(values)
+
+    @classmethod
+    def from_yaml(cls, path, node_name: str = NODE_NAME) -> "PipelineConfig":
         """From a YAML file: either ``{tracker: {...}, gyro: {...}, use_gyro: ..., imu_wait_ms: ...}``
-        (:meth:`from_dict`) or the node's ROS parameter file (``config/tracker.yaml``:
-        ``<node>: ros__parameters: ...``, nested ``tracker: {n_iter: 10}`` or dotted ``tracker.n_iter: 10``
-        as ROS accepts both), of which the pipeline's keys are used (node-only parameters such as
-        ``initial_box``, ``class_id`` or ``reliable_qos`` are ignored).  ValueError for a file that
-        cannot be read or holds invalid values."""
+        (:meth:`from_dict`) or a ROS parameter file (``config/tracker.yaml``), read as the node named
+        ``node_name`` would: the ``ros__parameters`` of wildcard sections (``/**``) and then of its
+        own section (its name, optionally under namespaces), by :meth:`from_parameters`.  ValueError
+        for a file that cannot be read, has no section for the node, or holds invalid values."""
         import yaml  # noqa: PLC0415 - only the command-line tools read configuration files
 
         path = Path(path)
         try:
             values = yaml.safe_load(path.read_text()) or {}
-        except (OSError, yaml.YAMLError) as exc:
+        except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
             raise ValueError(f"cannot read config {path}: {exc}") from None
         if not isinstance(values, dict):
             raise ValueError(f"config {path} must be a mapping")
-        ros = [v["ros__parameters"] for v in values.values() if isinstance(v, dict) and "ros__parameters" in v]
-        if ros:
-            if len(ros) > 1:
-                raise ValueError(f"config {path} holds parameters of {len(ros)} nodes; keep the tracker's only")
-            nested: dict = {}
-            for key, value in (ros[0] or {}).items():
-                group, _, name = str(key).partition(".")
-                if name:
-                    nested.setdefault(group, {})[name] = value
-                elif isinstance(value, dict):
-                    nested.setdefault(group, {}).update(value)
-                else:
-                    nested[group] = value
-            keys = {f.name for f in fields(cls)}
-            values = {k: v for k, v in nested.items() if k in keys}
-        return cls.from_dict(values)
+        sections = list(_parameter_sections(values))
+        if not sections:
+            return cls.from_dict(values)
+        wildcard = [p for name, p in sections if name.rsplit("/", 1)[-1] in ("*", "**")]
+        named = [(name, p) for name, p in sections if name.rsplit("/", 1)[-1] not in ("*", "**")]
+        if len(named) > 1:
+            named = [(name, p) for name, p in named if name.rsplit("/", 1)[-1] == node_name]
+            if len(named) != 1:
+                raise ValueError(f"config {path} holds parameters of {len(sections)} nodes "
+                                 f"({', '.join(name for name, _ in sections)}) and not one named {node_name}")
+        merged: dict = {}
+        for params in wildcard + [p for _, p in named]:
+            if not isinstance(params, dict):
+                raise ValueError(f"config {path}: ros__parameters must be a mapping, got {params!r}")
+            merged.update(params)
+        try:
+            return cls.from_parameters(merged)
+        except ValueError as exc:
+            raise ValueError(f"config {path}: {exc}") from None
 
     def to_dict(self) -> dict:
         d = {f.name: getattr(self, f.name) for f in fields(self)}

@@ -272,9 +272,26 @@ def test_config_from_yaml_reads_the_node_parameter_file_nested_or_dotted(tmp_pat
         configs.append(PipelineConfig.from_yaml(tmp_path / f"{name}.yaml"))
     assert configs[0].to_dict() == configs[1].to_dict() == configs[2].to_dict()
     assert configs[0].tracker.n_iter == 10 and not configs[0].use_gyro and configs[0].gyro.bias[0] == 0.1
-    for text, match in [("iemd_tracker:\n  ros__parameters:\n    tracker.n_iters: 10\n", "unknown tracker parameters"),
-                        ("a:\n  ros__parameters: {}\nb:\n  ros__parameters: {}\n", "parameters of 2 nodes"),
-                        ("- 1\n- 2\n", "must be a mapping"), ("tracker: [\n", "cannot read config")]:
+    # as rcl reads a parameter file: wildcard sections first, then the node's own (under namespaces too)
+    (tmp_path / "ns.yaml").write_text("/**:\n  ros__parameters:\n    tracker.n_iter: 7\n    imu_wait_ms: 5.0\n"
+                                      "robot:\n  iemd_tracker:\n    ros__parameters:\n      tracker.n_iter: 12\n"
+                                      "camera_driver:\n  ros__parameters:\n    use_gyro: 3\n")
+    ns = PipelineConfig.from_yaml(tmp_path / "ns.yaml")
+    assert (ns.tracker.n_iter, ns.imu_wait_ms, ns.use_gyro) == (12, 5.0, True)
+    node = "iemd_tracker:\n  ros__parameters:\n"
+    for text, match in [(node + "    tracker.n_iters: 10\n", "unknown tracker parameters"),
+                        ("a:\n  ros__parameters: {}\nb:\n  ros__parameters: {}\n", "2 nodes .*not one named"),
+                        ("- 1\n- 2\n", "must be a mapping"), ("tracker: [\n", "cannot read config"),
+                        (node + "    tracker: 5\n    tracker.n_iter: 3\n", "tracker must be a group"),
+                        (node + "    tracker.n_iter: 3\n    tracker: 5\n", "tracker must be a group"),
+                        ("iemd_tracker:\n  ros__parameters: [1, 2]\n", "ros__parameters must be a mapping"),
+                        ("tracker: [1, 2]\n", "tracker must be a mapping"),
+                        (node + "    tracker.n_iter: abc\n", "invalid pipeline parameters"),
+                        (node + "    use_gyro: 'no'\n", "use_gyro must be true or false"),
+                        (node + "    use_gyro.x: 1\n", "use_gyro is a single parameter")]:
         (tmp_path / "bad.yaml").write_text(text)
         with pytest.raises(ValueError, match=match):
             PipelineConfig.from_yaml(tmp_path / "bad.yaml")
+    (tmp_path / "latin1.yaml").write_bytes("tracker: {n_iter: 10}  # caf\xe9\n".encode("latin-1"))
+    with pytest.raises(ValueError, match="cannot read config .*latin1.yaml"):
+        PipelineConfig.from_yaml(tmp_path / "latin1.yaml")
