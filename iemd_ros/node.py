@@ -48,13 +48,12 @@ from .conversions import (CLASS_ID, DETECTION_ID, bbox_to_box, bbox_values, came
                           fill_bbox, fill_image_msg, image_from_msg, imu_sample, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
-from .pipeline import ERROR, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
+from .pipeline import ERROR, NODE_NAME, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
 from .spin import spin_until_shutdown
 from .tracker import TrackerConfig
 
 __all__ = ["TrackerNode", "main", "NODE_NAME"]
 
-NODE_NAME = "iemd_tracker"
 
 # Descriptions and ranges of the tracker parameters (``tracker.<field>`` of TrackerConfig).  The
 # ranges are the outer limits a GUI can offer; TrackerConfig's own validation (cross-field rules
@@ -168,11 +167,11 @@ class TrackerNode(Node):
         self._debug_pub = self.create_publisher(Image, "~/debug_image", 1)
         # image_transport's naming: the compressed stream of the (remapped) image topic is <image>/compressed.
         if transport == "compressed":
-            self._image_topic = self.resolve_topic_name("image") + "/compressed"
-            self.create_subscription(CompressedImage, self._image_topic, self._on_image, sensor_qos)
+            image_sub = self.create_subscription(CompressedImage, self.resolve_topic_name("image") + "/compressed",
+                                                 self._on_image, sensor_qos)
         else:
-            self._image_topic = self.resolve_topic_name("image")
-            self.create_subscription(Image, self._image_topic, self._on_image, sensor_qos)
+            image_sub = self.create_subscription(Image, "image", self._on_image, sensor_qos)
+        self._image_topic = image_sub.topic_name  # after remapping
         self.create_subscription(Imu, "imu", self._on_imu, imu_qos)
         self.create_subscription(CameraInfo, "camera_info", self._on_camera_info, sensor_qos)
         self.create_subscription(Detection2D, "~/init", self._on_init, 10)
@@ -231,10 +230,7 @@ class TrackerNode(Node):
         return {n: overrides[n] if n in overrides else self.get_parameter(n).value for n in self._declared}
 
     def _pipeline_config(self, overrides: dict) -> PipelineConfig:
-        v = self._values(overrides)
-        tracker = {k[8:]: v[k] for k in v if k.startswith("tracker.")}
-        gyro = {k[5:]: v[k] for k in v if k.startswith("gyro.")}
-        return PipelineConfig.from_dict({"tracker": tracker, "gyro": gyro, **{k: v[k] for k in _PIPELINE_DOC}})
+        return PipelineConfig.from_parameters(self._values(overrides))
 
     @staticmethod
     def _check_initial_box(value):

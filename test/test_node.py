@@ -31,11 +31,14 @@ def seq():
 
 
 @contextmanager
-def tracker_and_driver(ctx, compressed: str | None = None, **params):
-    """The tracker node with parameters ``params`` and a driver (publishing ``compressed`` images if given)."""
+def tracker_and_driver(ctx, compressed: str | None = None, image_topic: str = "image", **params):
+    """The tracker node with parameters ``params`` and a driver (publishing ``compressed`` images if given);
+    a non-default ``image_topic`` is remapped for the node (``-r image:=<image_topic>``)."""
     overrides = {"diagnostics_period_s": 0.1, "reliable_qos": True, "gyro.time_offset_ns": 4_000_000, **params}
-    node = TrackerNode(context=ctx, parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()])
-    driver = Driver(ctx, compressed=compressed)
+    remap = ["--ros-args", "-r", f"image:={image_topic}"] if image_topic != "image" else None
+    node = TrackerNode(context=ctx, cli_args=remap,
+                       parameter_overrides=[Parameter(k, value=v) for k, v in overrides.items()])
+    driver = Driver(ctx, image_topic=image_topic, compressed=compressed)
     try:
         with spinning(ctx, node, driver.node):
             assert driver.wait_connected(), "driver and tracker did not discover each other within 10 s"
@@ -249,14 +252,14 @@ def test_compressed_transport_tracks_as_raw_images_do(ctx, seq):
     png = _track_one_by_one(ctx, seq, 8, compressed="png", image_transport="compressed")
     assert len(raw) == 8 and png == raw
     s = [int(v) for v in seq.frame_stamps_ns]
-    with tracker_and_driver(ctx, "jpeg", image_transport="compressed", initial_box=[float(v) for v in seq.gt_boxes[0]],
-                            imu_wait_ms=0.0) as (node, drv):
+    with tracker_and_driver(ctx, "jpeg", image_topic="/cam/image_raw", image_transport="compressed",
+                            initial_box=[float(v) for v in seq.gt_boxes[0]], imu_wait_ms=0.0) as (node, drv):
         drv.publish_image(seq.frames[0], s[0])
         assert drv.wait_for(lambda: any(stamp_ns(d.header) == s[0] and d.detections for d in drv.detections), 10)
         drv.publish_image(seq.frames[1], s[1], data=b"\xff\xd8 truncated")       # does not decode
         st = drv.wait_status("image input", lambda x: level(x) == ERROR)
         assert st is not None and "cannot decode the compressed image" in st.message
-        assert values(st)["topic"] == "/image/compressed"
+        assert values(st)["topic"] == "/cam/image_raw/compressed"       # follows the remapped image topic
         drv.publish_image(seq.frames[2], s[2])                                    # still alive: tracked
         assert drv.wait_for(lambda: any(stamp_ns(d.header) == s[2] and d.detections for d in drv.detections), 10)
         assert node._worker.is_alive()
