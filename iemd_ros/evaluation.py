@@ -298,7 +298,8 @@ def sequence_names(wanted: str | None) -> list[str]:
 def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, iemd_config=None) -> dict:
     """Run every tracker on every sequence, write ``results.json`` and success plots into ``out``.
 
-    ``iemd_config``: the iEMD tracker's TrackerConfig (None: the defaults), recorded in ``results.json``.
+    ``iemd_config``: the iEMD tracker's TrackerConfig (None: the defaults), recorded in ``results.json``
+    when iEMD runs.
     """
     iemd_config = iemd_config if iemd_config is not None else TrackerConfig()
     out.mkdir(parents=True, exist_ok=True)
@@ -338,7 +339,7 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
         },
         "opencv_version": cv2.__version__,
         "trackers": trackers,
-        "iemd_config": iemd_config.to_dict(),
+        **({"iemd_config": iemd_config.to_dict()} if "iemd" in trackers else {}),
         "sequences": [s.name for s in sequences],
         "ground_truth": {s.name: s.gt_boxes.tolist() for s in sequences},
         "frame_numbers": {s.name: list(s.frame_numbers) for s in sequences},
@@ -360,6 +361,8 @@ def main(argv: list[str] | None = None) -> int:
         trackers = list(dict.fromkeys(args.trackers))
         for t in trackers:
             make_tracker(t)  # fail early on an unknown tracker or one that cannot be imported
+        if args.config and "iemd" not in trackers:
+            raise ValueError("--config sets the iemd tracker's parameters, but iemd is not among --trackers")
         iemd_config = PipelineConfig.from_yaml(args.config).tracker if args.config else None
         sequences = collect_sequences(args.inputs, args.sequences)
         if args.max_frames is not None:

@@ -95,6 +95,7 @@ def test_cli_real_excerpt_csrt_kcf(otb_root, tmp_path, capsys):
     assert rc == 0
     doc = json.loads((out / "results.json").read_text())
     assert {"protocol", "trackers", "sequences", "ground_truth", "results"} <= doc.keys()
+    assert "iemd_config" not in doc                                          # iEMD did not run
     assert doc["trackers"] == ["csrt", "kcf"] and doc["sequences"] == ["Car4"]
     for trk in ("csrt", "kcf"):
         car = doc["results"][trk]["Car4"]
@@ -142,7 +143,8 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
         (["--max-frames", "1", "--trackers", "kcf"], "must be >= 2"),
         (["--bogus"], "unrecognized arguments"),
         (["/no/such/dir", "--trackers", "kcf"], "neither an OTB root nor a sequence folder"),
-        (["--config", "/no/such/params.yaml", "--trackers", "kcf"], "cannot read config"),
+        (["--config", "/no/such/params.yaml", "--trackers", "iemd"], "cannot read config"),
+        (["--config", "config/tracker.yaml", "--trackers", "kcf"], "iemd is not among --trackers"),
     ],
 )
 def test_bad_arguments_exit_2_one_line(argv, match, capsys):
