@@ -10,10 +10,11 @@
   (:func:`iter_messages`).
 * :func:`select_topics`: the image / IMU / camera-info topics, auto-detected when a bag has exactly one
   topic of a type, else named (wrong type or ambiguity -> BagError).  The image topic is a
-  ``sensor_msgs/Image`` or a ``sensor_msgs/CompressedImage`` (image_transport's ``.../compressed``);
-  auto-detection prefers raw: one Image topic is taken even beside a compressed one (the usual
-  ``image_raw`` + ``image_raw/compressed`` pair carries the same frames, raw is lossless); a bag without
-  an Image topic gives its one CompressedImage topic.  Several topics of the preferred kind -> BagError.
+  ``sensor_msgs/Image`` or a ``sensor_msgs/CompressedImage`` (image_transport's ``<image>/compressed``);
+  auto-detection takes the one image topic that holds messages, where a compressed topic whose raw
+  twin ``<image>`` holds messages too does not count (the twins carry the same frames, raw is
+  lossless).  Any other mix (e.g. a depth Image beside a colour stream's ``/compressed``) -> BagError
+  naming the candidates.
 """
 from __future__ import annotations
 
@@ -231,9 +232,13 @@ class Topics:
     camera_info: str | None
 
 
+def _listing(topics: dict, names) -> str:
+    return ", ".join(f"{t} [{topics[t].msgtype}]" for t in sorted(names)) or "none"
+
+
 def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str, required: bool) -> str | None:
-    """The ``role`` topic: ``wanted`` if given (of one of ``msgtypes``), else the one topic of the first
-    type in ``msgtypes`` that the bag has; None (or BagError if ``required``) when it has none."""
+    """The ``role`` topic: ``wanted`` if given (of one of ``msgtypes``), else the one topic of those types
+    (images: :func:`_auto_image_topic`); None (or BagError if ``required``) when the bag has none."""
     expected = " or ".join(msgtypes)
     if wanted is not None:
         if wanted not in topics:
@@ -241,17 +246,26 @@ def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str
         if topics[wanted].msgtype not in msgtypes:
             raise BagError(f"{role} topic {wanted!r} has type {topics[wanted].msgtype}, expected {expected}")
         return wanted
-    for msgtype in msgtypes:
-        by_type = sorted(t for t, info in topics.items() if info.msgtype == msgtype)
-        if len(by_type) == 1:
-            return by_type[0]
-        if len(by_type) > 1:
-            flag = {"image": "--image-topic", "IMU": "--imu-topic", "camera-info": "--camera-info-topic"}[role]
-            raise BagError(f"the bag has {len(by_type)} {msgtype} topics ({', '.join(by_type)}); choose one with {flag}")
-    if required:
-        raise BagError(f"the bag has no {expected} topic (topics: "
-                       f"{', '.join(f'{t} [{i.msgtype}]' for t, i in sorted(topics.items())) or 'none'})")
-    return None
+    of_type = [t for t, info in topics.items() if info.msgtype in msgtypes]
+    if not of_type:
+        if required:
+            raise BagError(f"the bag has no {expected} topic (topics: {_listing(topics, topics)})")
+        return None
+    candidates = _auto_image_topic(topics, of_type) if role == "image" else of_type
+    if len(candidates) > 1:
+        flag = {"image": "--image-topic", "IMU": "--imu-topic", "camera-info": "--camera-info-topic"}[role]
+        raise BagError(f"the bag has {len(candidates)} {role} topics ({_listing(topics, candidates)}); "
+                       f"choose one with {flag}")
+    return candidates[0]
+
+
+def _auto_image_topic(topics: dict, images: list[str]) -> list[str]:
+    """The image topics auto-detection may take: those holding messages (all of them if none does),
+    without a compressed topic whose raw twin holds messages (module docstring)."""
+    filled = [t for t in images if topics[t].msgcount > 0] or images
+    raw = {t for t in filled if topics[t].msgtype == IMAGE_TYPE}
+    return [t for t in filled if not (topics[t].msgtype == COMPRESSED_IMAGE_TYPE and t.endswith("/compressed")
+                                      and t[:-len("/compressed")] in raw)]
 
 
 def select_topics(reader, image: str | None = None, imu: str | None = None,

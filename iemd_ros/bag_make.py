@@ -286,7 +286,7 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
         raise ValueError(f"{source.name} has no ground truth to write to {gt_out}")
     tp = dict(DEFAULT_TOPICS, **(topics or {}))
     if compress is not None:
-        if tp["image"].rstrip("/").endswith("/compressed"):
+        if tp["image"].rstrip("/").rsplit("/", 1)[-1] == "compressed":
             raise ValueError(f"--image-topic {tp['image']} ends in /compressed: give the raw topic, --compress "
                              "appends /compressed as image_transport does")
         tp["image"] = tp["image"].rstrip("/") + "/compressed"

@@ -206,9 +206,11 @@ def test_bad_input(seq, tmp_path, capsys):
                        ([str(folder), str(tmp_path / "o10"), "--compress", "jpeg", "--jpeg-quality", "0"],
                         "JPEG quality must be in [1, 100], got 0"),
                        ([str(folder), str(tmp_path / "o11"), "--compress", "jpeg", "--image-topic",
-                         "/c/image/compressed"], "ends in /compressed: give the raw topic")]:
+                         "/c/image/compressed"], "ends in /compressed: give the raw topic"),
+                       ([str(folder), str(tmp_path / "o12"), "--compress", "png", "--image-topic", "compressed"],
+                        "ends in /compressed: give the raw topic")]:
         assert text in cli_error(main, argv, capsys)
-    assert not any((tmp_path / f"o{k}").exists() for k in range(4, 12))        # no partial output
+    assert not any((tmp_path / f"o{k}").exists() for k in range(4, 13))        # no partial output
 
 
 def test_cli_compress_and_quality(seq, tmp_path, capsys):

@@ -162,9 +162,9 @@ def test_ros1_converted_matches_ros2_desk(imu_root, tmp_path):
     assert len(read_csv_rows(csvs["desk_ros2"])) == 9
 
 
-def _bag_with(path, *, image_topics=("/cam/image",), imu=False, bad_at=None, n=4, seq=None):
+def _bag_with(path, *, image_topics=("/cam/image",), imu=False, bad_at=None, n=4, seq=None, empty=()):
     """A hand-made bag: frames of ``seq`` on each image topic (bgr8 Image; PNG CompressedImage on a topic
-    ending in /compressed), optionally an IMU topic.  Frame ``bad_at`` is malformed."""
+    ending in /compressed) but those in ``empty``, optionally an IMU topic.  Frame ``bad_at`` is malformed."""
     with BagWriter(path, "mcap") as bag:
         for t in image_topics:
             bag.add_topic(t, COMPRESSED_IMAGE_TYPE if t.endswith("/compressed") else IMAGE_TYPE)
@@ -173,7 +173,7 @@ def _bag_with(path, *, image_topics=("/cam/image",), imu=False, bad_at=None, n=4
         for k in range(n):
             ts = int(seq.frame_stamps_ns[k])
             f = seq.frames[k]
-            for topic in image_topics:
+            for topic in (t for t in image_topics if t not in empty):
                 if topic.endswith("/compressed"):
                     msg = _compressed_msg(bag, topic, ts, "cam", f, "png")
                     if k == bad_at:
@@ -199,7 +199,8 @@ def test_no_imu_warns_and_tracks_without_gyro(seq, tmp_path, capsys):
 def test_topic_selection_and_malformed_image(seq, tmp_path, capsys):
     _bag_with(tmp_path / "two", image_topics=("/a/image", "/b/image"), seq=seq, bad_at=2)
     err = cli_error(main, [str(tmp_path / "two"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")], capsys)
-    assert "2 sensor_msgs/msg/Image topics" in err and "--image-topic" in err
+    assert "2 image topics (/a/image [sensor_msgs/msg/Image], /b/image [sensor_msgs/msg/Image])" in err
+    assert "choose one with --image-topic" in err
     assert main([str(tmp_path / "two"), "--init", _init(seq), "--image-topic", "/b/image",
                  "--csv", str(tmp_path / "o.csv")]) == 0
     rows = read_csv_rows(tmp_path / "o.csv")
@@ -209,8 +210,8 @@ def test_topic_selection_and_malformed_image(seq, tmp_path, capsys):
 
 def test_raw_or_compressed_image_topic(seq, tmp_path, capsys):
     """Without --image-topic the raw Image topic wins over its compressed twin (named in the summary); a
-    compressed topic alone is taken; several of the preferred kind ask for --image-topic; --image-topic
-    takes either type."""
+    compressed topic alone, or beside an empty raw twin, is taken; other mixes ask for --image-topic;
+    --image-topic takes either type."""
     init, csv_a, csv_b = _init(seq), str(tmp_path / "a.csv"), str(tmp_path / "b.csv")
     _bag_with(tmp_path / "both", image_topics=("/cam/image", "/cam/image/compressed"), seq=seq)
     assert main([str(tmp_path / "both"), "--init", init, "--csv", csv_a]) == 0
@@ -225,11 +226,21 @@ def test_raw_or_compressed_image_topic(seq, tmp_path, capsys):
     assert Path(csv_a).read_bytes() == Path(csv_b).read_bytes()
     _bag_with(tmp_path / "cc", image_topics=("/a/compressed", "/b/compressed"), seq=seq)
     err = cli_error(main, [str(tmp_path / "cc"), "--init", init, "--csv", csv_b], capsys)
-    assert "2 sensor_msgs/msg/CompressedImage topics (/a/compressed, /b/compressed); choose one with " \
-           "--image-topic" in err
-    _bag_with(tmp_path / "rrc", image_topics=("/a/image", "/b/image", "/a/compressed"), seq=seq)
+    assert "2 image topics (/a/compressed [sensor_msgs/msg/CompressedImage], /b/compressed [" in err
+    assert err.endswith("choose one with --image-topic")
+    _bag_with(tmp_path / "rrc", image_topics=("/a/image", "/b/image", "/a/image/compressed"), seq=seq)
     err = cli_error(main, [str(tmp_path / "rrc"), "--init", init, "--csv", csv_b], capsys)
-    assert "2 sensor_msgs/msg/Image topics (/a/image, /b/image); choose one with --image-topic" in err
+    assert "2 image topics (/a/image [sensor_msgs/msg/Image], /b/image [sensor_msgs/msg/Image]); choose" in err
+    # a depth Image beside a colour stream's /compressed: not twins, so no guess
+    _bag_with(tmp_path / "depth", image_topics=("/depth/image", "/color/image/compressed"), seq=seq)
+    err = cli_error(main, [str(tmp_path / "depth"), "--init", init, "--csv", csv_b], capsys)
+    assert "2 image topics (/color/image/compressed [sensor_msgs/msg/CompressedImage], /depth/image [" in err
+    # a raw twin without messages: the compressed stream is the one with frames
+    _bag_with(tmp_path / "empty", image_topics=("/cam/image", "/cam/image/compressed"), empty=("/cam/image",),
+              seq=seq)
+    assert main([str(tmp_path / "empty"), "--init", init, "--csv", csv_b]) == 0
+    assert "4 images from /cam/image/compressed: " in capsys.readouterr().out
+    assert Path(csv_a).read_bytes() == Path(csv_b).read_bytes()
 
 
 def test_corrupt_compressed_frame_is_counted(seq, tmp_path):
