@@ -11,7 +11,7 @@ to the arrival of the Detection2DArray carrying its stamp (both on the driver's 
 * ``process-shm``: the same with ``config/fastdds_shm.xml`` (FASTRTPS_DEFAULT_PROFILES_FILE) in both;
 * ``process-jpeg``: the tracker process with ``image_transport`` "compressed", the frames published as
   JPEG (quality 95) CompressedImage on ``image/compressed``; its latency includes the decoding
-  (1-2 ms; "track ms" is the tracker alone).
+  (about 1.4 ms; "track ms" is the tracker alone).
 
 Peer, measured in the same run and setup: an echo node that answers each image with an empty
 Detection2DArray at once (transport + rclpy overhead only).  Frames the tracker drops as stale (it

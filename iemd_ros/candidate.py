@@ -58,7 +58,7 @@ class TargetModel:
         return (self.eps**2).sum(1)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SearchContext:
     """What the candidate windows of one search on one frame are sampled from and compared against.
 

@@ -290,7 +290,8 @@ class IemdTracker:
         gain (12-sequence average overlap 31.3 vs 31.9 %: a wider basin also
         reaches distractors) and updates took 3x longer, so it was not kept.
         """
-        fine, coarse = self._context(pyramid, angle), self._context(pyramid, angle, coarse=True)
+        fine = self._context(pyramid, angle)
+        coarse = self._context(pyramid, angle, coarse=True) if self.config.coarse_to_fine else None
         scored, warnings = [], 0
         for start in starts:
             if self.config.coarse_to_fine:
