@@ -236,9 +236,10 @@ def _listing(topics: dict, names) -> str:
     return ", ".join(f"{t} [{topics[t].msgtype}]" for t in sorted(names)) or "none"
 
 
-def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str, required: bool) -> str | None:
+def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str, required: bool,
+          narrow=lambda topics, names: names) -> str | None:
     """The ``role`` topic: ``wanted`` if given (of one of ``msgtypes``), else the one topic of those types
-    (images: :func:`_auto_image_topic`); None (or BagError if ``required``) when the bag has none."""
+    that ``narrow(topics, names)`` keeps; None (or BagError if ``required``) when the bag has none."""
     expected = " or ".join(msgtypes)
     if wanted is not None:
         if wanted not in topics:
@@ -251,7 +252,7 @@ def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str
         if required:
             raise BagError(f"the bag has no {expected} topic (topics: {_listing(topics, topics)})")
         return None
-    candidates = _auto_image_topic(topics, of_type) if role == "image" else of_type
+    candidates = narrow(topics, of_type)
     if len(candidates) > 1:
         flag = {"image": "--image-topic", "IMU": "--imu-topic", "camera-info": "--camera-info-topic"}[role]
         raise BagError(f"the bag has {len(candidates)} {role} topics ({_listing(topics, candidates)}); "
@@ -259,7 +260,7 @@ def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str
     return candidates[0]
 
 
-def _auto_image_topic(topics: dict, images: list[str]) -> list[str]:
+def _image_candidates(topics: dict, images: list[str]) -> list[str]:
     """The image topics auto-detection may take: those holding messages (all of them if none does),
     without a compressed topic whose raw twin holds messages (module docstring)."""
     filled = [t for t in images if topics[t].msgcount > 0] or images
@@ -272,7 +273,7 @@ def select_topics(reader, image: str | None = None, imu: str | None = None,
                   camera_info: str | None = None) -> Topics:
     """Choose the image, IMU and camera-info topics of an open reader (see module docstring)."""
     topics = reader.topics
-    img = _pick(topics, IMAGE_TYPES, image, "image", True)
+    img = _pick(topics, IMAGE_TYPES, image, "image", True, narrow=_image_candidates)
     if topics[img].msgcount == 0:
         raise BagError(f"image topic {img!r} holds no message")
     return Topics(img, _pick(topics, (IMU_TYPE,), imu, "IMU", False),
