@@ -21,7 +21,7 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import TrackerConfig
-from iemd_ros.evaluation import IemdAdapter, make_tracker, run_tracker, sequence_names
+from iemd_ros.evaluation import make_tracker, run_tracker, sequence_names
 from iemd_ros.metrics import score_sequence
 from iemd_ros.otb import default_root, load_sequence
 
@@ -35,11 +35,11 @@ def run(job):
     frames = list(seq.frames())
     first = np.asarray(seq.gt_boxes[0], dtype=float)
     out = []
-    for label, config in runs:
+    for label, tracker_name, config in runs:
         rows = []
         for direction in DIAGONALS:
             start = first + np.array([direction[0] * shift * first[2], direction[1] * shift * first[3], 0.0, 0.0])
-            tracker = IemdAdapter(config) if config is not None else make_tracker(label)
+            tracker = make_tracker(tracker_name, config)
             result = run_tracker(tracker, frames, start)
             scores = score_sequence(result.boxes, seq.gt_boxes, name)
             rows.append((scores.average_overlap, float(np.median(result.update_seconds) * 1e3)))
@@ -57,17 +57,17 @@ def main() -> None:
     args = parser.parse_args()
     names = sequence_names(args.sequences)
     # Checked here, before any run: a bad key or peer fails at once with its own message.
-    runs = [(f"iemd {c}" if args.config else "iemd", TrackerConfig.from_dict(ast.literal_eval(c)))
+    runs = [(f"iemd {c}" if args.config else "iemd", "iemd", TrackerConfig.from_dict(ast.literal_eval(c)))
             for c in (args.config or ["{}"])]
     peers = [peer for peer in args.peers.split(",") if peer]
     for peer in peers:
         make_tracker(peer)
-    runs += [(peer, None) for peer in peers]
+    runs += [(peer, peer, None) for peer in peers]
     with Pool(args.jobs) as pool:
         results = pool.map(run, [(name, runs, args.shift) for name in names], chunksize=1)
     print(f"{len(names)} sequences x {len(DIAGONALS)} starts (ground truth, and shifted by {args.shift:g} of its "
           "size along the diagonals)")
-    for i, (label, _) in enumerate(runs):
+    for i, (label, _, _) in enumerate(runs):
         rows = [row for per_sequence in results for row in per_sequence[i]]
         overlap = np.array([ao for ao, _ in rows]).reshape(len(names), len(DIAGONALS)) * 100
         speed = np.median([ms for _, ms in rows])

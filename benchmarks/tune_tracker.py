@@ -21,7 +21,7 @@ import numpy as np
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.evaluation import IemdAdapter, evaluate_sequence
+from iemd_ros.evaluation import evaluate_sequence, make_tracker
 from iemd_ros.boxes import box_centre
 from iemd_ros.candidate import CandidateModel
 from iemd_ros.otb import default_root, load_sequence, read_frame
@@ -32,7 +32,7 @@ def overlap(job):
     seq = load_sequence(name, default_root())
     if frames:
         seq = seq.head(frames)
-    scores, run = evaluate_sequence(seq, IemdAdapter(config))
+    scores, run = evaluate_sequence(seq, make_tracker("iemd", config))
     return scores.average_overlap, float(np.median(run.update_seconds) * 1e3)
 
 

@@ -89,10 +89,13 @@ class IemdAdapter:
         return np.asarray(result.box, dtype=float), not bool(result.lost)
 
 
-def _opencv_factory(kind: str) -> Callable[[], OpenCVTracker]:
-    """CSRT/KCF: OpenCV 5 contrib has ``cv2.TrackerCSRT.create``; older builds ``cv2.TrackerCSRT_create``."""
+def _opencv_factory(kind: str) -> Callable[..., OpenCVTracker]:
+    """CSRT/KCF: OpenCV 5 contrib has ``cv2.TrackerCSRT.create``; older builds ``cv2.TrackerCSRT_create``.
+    They run with OpenCV's defaults: a configuration is refused."""
 
-    def factory() -> OpenCVTracker:
+    def factory(config=None) -> OpenCVTracker:
+        if config is not None:
+            raise ValueError(f"OpenCV's {kind} tracker runs with its defaults; it takes no configuration")
         cls = getattr(cv2, f"Tracker{kind}", None)
         create = getattr(cls, "create", None) or getattr(cv2, f"Tracker{kind}_create", None)
         if create is None:
@@ -102,21 +105,22 @@ def _opencv_factory(kind: str) -> Callable[[], OpenCVTracker]:
     return factory
 
 
-#: name -> factory returning a fresh :class:`TrackerAdapter`.
-TRACKERS: dict[str, Callable[[], TrackerAdapter]] = {
+#: name -> factory returning a fresh :class:`TrackerAdapter` with its defaults, or with ``factory(config)``
+#: for a tracker that has a configuration (iEMD: a TrackerConfig).
+TRACKERS: dict[str, Callable[..., TrackerAdapter]] = {
     "iemd": IemdAdapter,
     "csrt": _opencv_factory("CSRT"),
     "kcf": _opencv_factory("KCF"),
 }
 
 
-def make_tracker(name: str, iemd_config=None) -> TrackerAdapter:
-    """Build a tracker adapter by name (``iemd_config``: the iEMD tracker's TrackerConfig, None for the
-    defaults); ValueError for an unknown or unavailable tracker."""
+def make_tracker(name: str, config=None) -> TrackerAdapter:
+    """Build a tracker adapter by name, with its ``config`` (None: the tracker's defaults); ValueError for
+    an unknown or unavailable tracker."""
     if name not in TRACKERS:
         raise ValueError(f"unknown tracker {name!r} (known: {', '.join(TRACKERS)})")
     try:
-        return IemdAdapter(iemd_config) if name == "iemd" else TRACKERS[name]()
+        return TRACKERS[name]() if config is None else TRACKERS[name](config)
     except ImportError as exc:
         raise ValueError(f"tracker {name!r} is not available: {exc}") from None
 
@@ -295,19 +299,19 @@ def sequence_names(wanted: str | None) -> list[str]:
     return [seq.name for seq in collect_sequences([], wanted.split(",") if wanted else None)]
 
 
-def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, iemd_config=None) -> dict:
+def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, configs=None) -> dict:
     """Run every tracker on every sequence, write ``results.json`` and success plots into ``out``.
 
-    ``iemd_config``: the iEMD tracker's TrackerConfig (None: the defaults), recorded in ``results.json``
-    when iEMD runs.
+    ``configs``: tracker name -> its configuration (:func:`make_tracker`; absent: the defaults).  The iEMD
+    configuration is recorded in ``results.json`` when iEMD runs.
     """
-    iemd_config = iemd_config if iemd_config is not None else TrackerConfig()
+    configs = configs or {}
     out.mkdir(parents=True, exist_ok=True)
     results: dict[str, dict] = {t: {} for t in trackers}
     per_seq_scores: dict[str, list[SequenceScores]] = {t: [] for t in trackers}
     for seq in sequences:
         for trk in trackers:
-            scores, run = evaluate_sequence(seq, make_tracker(trk, iemd_config))
+            scores, run = evaluate_sequence(seq, make_tracker(trk, configs.get(trk)))
             per_seq_scores[trk].append(scores)
             entry = scores.to_dict()
             entry.update(
@@ -339,7 +343,7 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
         },
         "opencv_version": cv2.__version__,
         "trackers": trackers,
-        **({"iemd_config": iemd_config.to_dict()} if "iemd" in trackers else {}),
+        **({"iemd_config": configs.get("iemd", TrackerConfig()).to_dict()} if "iemd" in trackers else {}),
         "sequences": [s.name for s in sequences],
         "ground_truth": {s.name: s.gt_boxes.tolist() for s in sequences},
         "frame_numbers": {s.name: list(s.frame_numbers) for s in sequences},
@@ -363,14 +367,14 @@ def main(argv: list[str] | None = None) -> int:
             make_tracker(t)  # fail early on an unknown tracker or one that cannot be imported
         if args.config and "iemd" not in trackers:
             raise ValueError("--config sets the iemd tracker's parameters, but iemd is not among --trackers")
-        iemd_config = PipelineConfig.from_yaml(args.config).tracker if args.config else None
+        configs = {"iemd": PipelineConfig.from_yaml(args.config).tracker} if args.config else {}
         sequences = collect_sequences(args.inputs, args.sequences)
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
         t_start = time.perf_counter()
         print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) -> {args.out}"
               + (f" (iEMD parameters from {args.config})" if args.config else ""))
-        doc = evaluate(sequences, trackers, args.out, iemd_config=iemd_config)  # unreadable image, unwritable --out: one line, exit 2
+        doc = evaluate(sequences, trackers, args.out, configs=configs)  # unreadable image, unwritable --out: one line, exit 2
         print()
         print(format_table(doc["results"], trackers, doc["sequences"]))
         print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}")
