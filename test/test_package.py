@@ -2,11 +2,10 @@
 every module the package imports is declared (package.xml) or pip-installed (requirements.txt)."""
 import ast
 import re
+import sys
 
-import pytest
+from catkin_pkg import package as catkin_package
 from helpers import REPO
-
-catkin_package = pytest.importorskip("catkin_pkg.package")
 
 # Top-level module -> its rosdep key.
 ROSDEP_KEYS = {"cv2": "python3-opencv", "numpy": "python3-numpy", "yaml": "python3-yaml",
@@ -43,7 +42,7 @@ def test_every_imported_module_is_declared():
     requirements = {re.split(r"[\[=<>]", line)[0].strip().lower()
                     for line in (REPO / "requirements.txt").read_text().splitlines()
                     if line.strip() and not line.startswith("#")}
-    stdlib = set(__import__("sys").stdlib_module_names) | {"iemd_ros"}
+    stdlib = set(sys.stdlib_module_names) | {"iemd_ros"}
     third_party = _imported_modules() - stdlib
     assert {"rclpy", "sensor_msgs", "vision_msgs", "cv2", "numba", "ot"} <= third_party  # the scan sees them
     for module in sorted(third_party):
