@@ -115,7 +115,7 @@ class _Descent:
     emd: float
     iterations: int = 0
     codings: int = 0  # candidate models built (_descend: its trial steps; _search adds the starts')
-    warnings: int = 0  # EMD solves that did not end optimal
+    warnings: int = 0  # EMD solves that did not end optimal (likewise: the trials', the starts' by _search)
 
     @property
     def center(self) -> np.ndarray:
@@ -294,15 +294,15 @@ class IemdTracker:
         coarse = self._context(pyramid, angle, coarse=True) if self.config.coarse_to_fine else None
         scored, warnings = [], 0
         for start in starts:
-            if self.config.coarse_to_fine:
-                stage = self._descend(CandidateModel(coarse, start, size))
-                start, warnings = stage.center, warnings + stage.warnings
+            if coarse is not None:
+                first = CandidateModel(coarse, start, size)
+                stage = self._descend(first)
+                start, warnings = stage.center, warnings + stage.warnings + _not_optimal(first.emd()[1])
             model = CandidateModel(fine, start, size)
             scored.append((*model.emd(), model))
-        winner = min(scored, key=lambda item: item[0])[2]
-        best = self._descend(winner)  # counts the winner's solve (cached from the scoring)
+        best = self._descend(min(scored, key=lambda item: item[0])[2])  # the winner's EMD is cached
         best.codings += len(scored)
-        best.warnings += warnings + sum(_not_optimal(sol) for _, sol, m in scored if m is not winner)
+        best.warnings += warnings + sum(_not_optimal(sol) for _, sol, _ in scored)
         return best
 
     def _descend(self, model: CandidateModel) -> _Descent:
@@ -317,8 +317,8 @@ class IemdTracker:
         cfg = self.config
         half = model.size / 2.0
         axes = window_axes(model.angle)
-        emd, grad, sol = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
-        state = _Descent(model=model, emd=emd, warnings=_not_optimal(sol))
+        emd, grad, _ = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
+        state = _Descent(model=model, emd=emd)  # its solve is counted by the caller, with its coding
         # A coarse stage samples ``coarse`` pyramid levels up: its steps are that much longer.
         level_scale = 2.0 ** model.coarse
         step, min_step = cfg.step_px * level_scale, cfg.min_step_px * level_scale
