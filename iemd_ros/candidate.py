@@ -87,22 +87,14 @@ class CandidateModel:
         self.context = context
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
-        self.template = context.pyramid.sample(self.center, self.size, self.layout.template_size, self.coarse,
-                                               self.angle)
-        self.eps = self.layout.extract(self.template)
-        self.pos = self.layout.positions()
-        dictionary = context.dictionary
+        layout, target, dictionary = context.layout, context.target, context.dictionary
+        self.template = context.pyramid.sample(self.center, self.size, layout.template_size, context.coarse,
+                                               context.angle)
+        self.eps = layout.extract(self.template)
+        self.pos = layout.positions()
         self.code_weights = np.ones(len(self.eps)) if dictionary is None else dictionary.code_weights(self.eps)
-        self.appearance_cost = context.alpha * appearance_distance(self.target.eps, self.eps, self.target.eps_sq_norms)
+        self.appearance_cost = context.alpha * appearance_distance(target.eps, self.eps, target.eps_sq_norms)
         self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
-
-    @property
-    def target(self) -> TargetModel:
-        return self.context.target
-
-    @property
-    def layout(self) -> PatchLayout:
-        return self.context.layout
 
     @property
     def coarse(self) -> int:
@@ -126,7 +118,7 @@ class CandidateModel:
         Computed on first use: the descent needs it only where a step is accepted
         (about 4 in 10 models; rejected trials and scale variants need only the EMD).
         """
-        return self.layout.extract_with_jacobian(self.template)[1]
+        return self.context.layout.extract_with_jacobian(self.template)[1]
 
     def evaluate(self, gradient: str, y=(0.0, 0.0)):
         """EMD between the target and the kernel centred at offset ``y`` (normalized), and dEMD/dy.
@@ -150,8 +142,8 @@ class CandidateModel:
         if keep.size == 0:
             self._solved = None
             return np.inf, None
-        cost = _transport_cost(self.appearance_cost, keep, self.target.pos, self.pos, y, 1.0 - self.context.alpha)
-        solution: EmdSolution = solve_emd(self.target.weights, w_c[keep], cost, check=False)
+        cost = _transport_cost(self.appearance_cost, keep, self.context.target.pos, self.pos, y, 1.0 - self.context.alpha)
+        solution: EmdSolution = solve_emd(self.context.target.weights, w_c[keep], cost, check=False)
         self._solved = (y, keep, dw_dy[keep], solution)
         return solution.value, solution
 
@@ -174,7 +166,7 @@ class CandidateModel:
         if kind == "paper":
             return emd_gradient(solution, dw_dy)
         if kind == "envelope":
-            diff = self.target.pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
+            diff = self.context.target.pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
             return envelope_gradient(solution, dw_dy, 2.0 * (1.0 - self.context.alpha) * diff)
         if kind == "appearance":
             if np.any(y != 0):
@@ -182,9 +174,9 @@ class CandidateModel:
             flow = solution.flow
             # Per image pixel along the window's axes the Jacobian scales by T / size, and per
             # normalized unit by size / 2: together -2 alpha (T / 2) sum r . d eps / d(template px).
-            contraction = _appearance_contraction(flow.T @ self.target.eps, flow.sum(0), keep, self.eps,
+            contraction = _appearance_contraction(flow.T @ self.context.target.eps, flow.sum(0), keep, self.eps,
                                                   self.patch_jacobian)
-            return -self.context.alpha * np.asarray(self.layout.template_size, dtype=np.float64) * contraction
+            return -self.context.alpha * np.asarray(self.context.layout.template_size, dtype=np.float64) * contraction
         raise ValueError(f"unknown gradient {kind!r}")
 
 
