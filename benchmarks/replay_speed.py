@@ -29,8 +29,8 @@ import time
 from pathlib import Path
 
 from iemd_ros.bag_io import deserialize, iter_messages, open_bag, select_topics
-from iemd_ros.bag_make import COMPRESSIONS, source_from_folder, write_bag
-from iemd_ros.conversions import image_from_msg
+from iemd_ros.bag_make import source_from_folder, write_bag
+from iemd_ros.conversions import COMPRESSED_CODECS, image_from_msg
 from iemd_ros.metrics import iou
 from iemd_ros.replay import replay
 
@@ -60,7 +60,7 @@ def main() -> int:
     ap.add_argument("--desk", type=Path, default=DESK, help="cmu_hwangbo_desk folder")
     ap.add_argument("--frames", type=int, default=None, help="first N frames only (default: all 825)")
     ap.add_argument("--no-gyro-too", action="store_true", help="also replay without the gyro prior")
-    ap.add_argument("--compress", nargs="+", choices=COMPRESSIONS, default=[],
+    ap.add_argument("--compress", nargs="+", choices=COMPRESSED_CODECS, default=[],
                     help="also replay the frames as CompressedImage bags of these codecs")
     ap.add_argument("--keep", type=Path, default=None, help="write the bags into this folder and keep them")
     a = ap.parse_args()

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .conversions import ns_to_stamp
+from .conversions import ns_to_stamp, raw_twin
 from .cli import one_line
 
 __all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE",
@@ -265,8 +265,7 @@ def _image_candidates(topics: dict, images: list[str]) -> list[str]:
     without a compressed topic whose raw twin holds messages (module docstring)."""
     filled = [t for t in images if topics[t].msgcount > 0] or images
     raw = {t for t in filled if topics[t].msgtype == IMAGE_TYPE}
-    return [t for t in filled if not (topics[t].msgtype == COMPRESSED_IMAGE_TYPE and t.endswith("/compressed")
-                                      and t[:-len("/compressed")] in raw)]
+    return [t for t in filled if not (topics[t].msgtype == COMPRESSED_IMAGE_TYPE and raw_twin(t) in raw)]
 
 
 def select_topics(reader, image: str | None = None, imu: str | None = None,

@@ -56,19 +56,18 @@ from .bag_io import (CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, FORMATS, IMAGE_TYP
                      BagWriter, Progress, camera_info_fields, header)
 from .camera import CameraModel
 from .cli import CliParser, cli_main
-from .conversions import array_to_compressed_fields
+from .conversions import (COMPRESSED_CODECS, JPEG_QUALITY, array_to_compressed_fields, check_compression,
+                          compressed_topic)
 from .otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
 from .recordings import seconds_to_ns, load_recording
 
 __all__ = ["BagSource", "source_from_folder", "source_from_synthetic", "write_bag", "main",
-           "DEFAULT_TOPICS", "ENCODINGS", "COMPRESSIONS"]
+           "DEFAULT_TOPICS", "ENCODINGS"]
 
 DEFAULT_TOPICS = dict(image="/camera/image_raw", camera_info="/camera/camera_info", imu="/imu/data")
 CAMERA_FRAME = "camera_optical_frame"
 IMU_FRAME = "imu_link"
 ENCODINGS = ("bgr8", "mono8")
-COMPRESSIONS = ("jpeg", "png")
-JPEG_QUALITY = 95   # image_transport's compressed plugin default
 _BASE_NS = 1_000_000_000   # stamps of frame-rate-only sources start at 1 s (0 often means "unset")
 
 
@@ -269,11 +268,11 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
     ``"png"``: CompressedImage on the image topic + ``/compressed`` (module docstring)."""
     if encoding not in ENCODINGS:
         raise ValueError(f"encoding must be one of {', '.join(ENCODINGS)}, got {encoding!r}")
-    if compress is not None and compress not in COMPRESSIONS:
-        raise ValueError(f"--compress must be one of {', '.join(COMPRESSIONS)}, got {compress!r}")
     if jpeg_quality is not None and compress != "jpeg":
         raise ValueError(f"--jpeg-quality applies to --compress jpeg only (got --compress {compress or 'off'})")
     quality = JPEG_QUALITY if jpeg_quality is None else jpeg_quality
+    if compress is not None:
+        check_compression(compress, quality)  # before the bag is opened
     n = len(source)
     if not 0 <= first < n:
         raise ValueError(f"--first {first} is outside the {n} frames of {source.name}")
@@ -286,10 +285,10 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
         raise ValueError(f"{source.name} has no ground truth to write to {gt_out}")
     tp = dict(DEFAULT_TOPICS, **(topics or {}))
     if compress is not None:
-        if tp["image"].rstrip("/").rsplit("/", 1)[-1] == "compressed":
+        if tp["image"].rstrip("/").rpartition("/")[2] == "compressed":
             raise ValueError(f"--image-topic {tp['image']} ends in /compressed: give the raw topic, --compress "
                              "appends /compressed as image_transport does")
-        tp["image"] = tp["image"].rstrip("/") + "/compressed"
+        tp["image"] = compressed_topic(tp["image"])
     frame_t = np.asarray(source.frame_stamps_ns[first:last], dtype=np.int64)
     shift = -int(source.time_offset_ns)                    # IMU clock -> camera clock
     imu_idx = imu_t = None
@@ -362,7 +361,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("out", type=Path, help="output: rosbag2 folder (mcap/sqlite3) or FILE.bag (--format ros1)")
     p.add_argument("--format", choices=FORMATS, default="mcap", help="bag format (default mcap)")
     p.add_argument("--encoding", choices=ENCODINGS, default="bgr8", help="Image encoding (default bgr8)")
-    p.add_argument("--compress", choices=COMPRESSIONS, default=None,
+    p.add_argument("--compress", choices=COMPRESSED_CODECS, default=None,
                    help="write sensor_msgs/CompressedImage (image_transport format) on IMAGE_TOPIC/compressed "
                         "instead of raw Image (default: raw)")
     p.add_argument("--jpeg-quality", type=int, default=None, metavar="Q",

@@ -24,13 +24,16 @@ import numpy as np
 from .camera import CameraModel
 from .boxes import box_centre, centre_box, check_box
 
-__all__ = ["ENCODINGS", "image_to_array", "compressed_to_array", "array_to_image_fields", "array_to_compressed_fields", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
+__all__ = ["ENCODINGS", "COMPRESSED_CODECS", "JPEG_QUALITY", "image_to_array", "compressed_to_array",
+           "array_to_image_fields", "array_to_compressed_fields", "check_compression", "compressed_topic", "raw_twin", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
            "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
            "bbox_values", "fill_bbox",
            "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
 
 # encoding -> (channels, bytes per channel)
 ENCODINGS = {"mono8": (1, 1), "mono16": (1, 2), "bgr8": (3, 1), "rgb8": (3, 1), "bgra8": (4, 1), "rgba8": (4, 1)}
+COMPRESSED_CODECS = ("jpeg", "png")  # image_transport's compressed plugin
+JPEG_QUALITY = 95  # its default quality
 
 
 def _as_bytes(data) -> memoryview:
@@ -124,9 +127,7 @@ def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dic
     ``encoding`` defaults to mono8 for ``HxW`` and bgr8 for ``HxWx3`` uint8 frames; rgb8 flips the
     channels.  :func:`fill_image_msg` sets them on a message.
     """
-    frame = np.asarray(frame)
-    if frame.dtype != np.uint8 or frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
-        raise ValueError(f"frame must be HxW or HxWx3 uint8, got {frame.dtype} {frame.shape}")
+    frame = _check_frame(frame)
     default = "mono8" if frame.ndim == 2 else "bgr8"
     encoding = default if encoding is None else encoding
     if encoding not in (default, "rgb8" if frame.ndim == 3 else default):
@@ -139,18 +140,41 @@ def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dic
                 data=np.ascontiguousarray(frame).tobytes())
 
 
-def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: int = 95) -> dict:
+def _check_frame(frame) -> np.ndarray:
+    """``frame`` as an array, checked to be a tracker frame (``HxW`` or ``HxWx3`` uint8)."""
+    frame = np.asarray(frame)
+    if frame.dtype != np.uint8 or frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
+        raise ValueError(f"frame must be HxW or HxWx3 uint8, got {frame.dtype} {frame.shape}")
+    return frame
+
+
+def check_compression(codec: str, quality: int = JPEG_QUALITY) -> None:
+    """ValueError unless ``codec`` is one of :data:`COMPRESSED_CODECS` and ``quality`` a JPEG quality 1-100."""
+    if codec not in COMPRESSED_CODECS:
+        raise ValueError(f"codec must be 'jpeg' or 'png', got {codec!r}")
+    if not 1 <= int(quality) <= 100:
+        raise ValueError(f"JPEG quality must be in [1, 100], got {quality}")
+
+
+def compressed_topic(image_topic: str) -> str:
+    """image_transport's name of an image topic's compressed stream: ``<image_topic>/compressed``."""
+    return image_topic.rstrip("/") + "/compressed"
+
+
+def raw_twin(topic: str) -> str | None:
+    """The image topic whose compressed stream ``topic`` is named as (inverse of :func:`compressed_topic`);
+    None for a name that is not ``<image>/compressed``."""
+    head, _, last = topic.rstrip("/").rpartition("/")
+    return head if last == "compressed" and head else None
+
+
+def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: int = JPEG_QUALITY) -> dict:
     """Tracker frame -> ``sensor_msgs/CompressedImage`` fields as image_transport's compressed plugin
     writes them: ``format`` ``"bgr8; jpeg compressed bgr8"``, for ``HxW`` ``"mono8; jpeg compressed "``
     (the plugin names a target encoding for colour only; ``png`` is lossless) and the encoded ``data``
     as ``bytes``.  ``quality``: JPEG quality, 1-100."""
-    frame = np.asarray(frame)
-    if frame.dtype != np.uint8 or frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
-        raise ValueError(f"frame must be HxW or HxWx3 uint8, got {frame.dtype} {frame.shape}")
-    if codec not in ("jpeg", "png"):
-        raise ValueError(f"codec must be 'jpeg' or 'png', got {codec!r}")
-    if not 1 <= int(quality) <= 100:
-        raise ValueError(f"JPEG quality must be in [1, 100], got {quality}")
+    frame = _check_frame(frame)
+    check_compression(codec, quality)
     params = [cv2.IMWRITE_JPEG_QUALITY, int(quality)] if codec == "jpeg" else []
     ok, buf = cv2.imencode(".jpg" if codec == "jpeg" else ".png", frame, params)
     if not ok:

@@ -45,7 +45,7 @@ from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithP
 from .boxes import check_box
 from .cli import one_line
 from .conversions import (CLASS_ID, DETECTION_ID, bbox_to_box, bbox_values, camera_model_from_msg, detection_values,
-                          fill_bbox, fill_image_msg, image_from_msg, imu_sample, stamp_ns)
+                          compressed_topic, fill_bbox, fill_image_msg, image_from_msg, imu_sample, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
 from .pipeline import ERROR, NODE_NAME, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
@@ -167,7 +167,7 @@ class TrackerNode(Node):
         self._debug_pub = self.create_publisher(Image, "~/debug_image", 1)
         # image_transport's naming: the compressed stream of the (remapped) image topic is <image>/compressed.
         if transport == "compressed":
-            image_sub = self.create_subscription(CompressedImage, self.resolve_topic_name("image") + "/compressed",
+            image_sub = self.create_subscription(CompressedImage, compressed_topic(self.resolve_topic_name("image")),
                                                  self._on_image, sensor_qos)
         else:
             image_sub = self.create_subscription(Image, "image", self._on_image, sensor_qos)
