@@ -93,10 +93,12 @@ NODE_NAME = "iemd_tracker"  # the tracker node's default name (iemd_ros.node), a
 
 
 def _parameter_sections(tree: dict, names: tuple = ()):
-    """(node path, its ``ros__parameters``) of every section of a ROS parameter file, namespaces included."""
+    """(node path, node name, its ``ros__parameters``) of every section of a ROS parameter file, namespaces
+    included (the node name is the path's last part: ``**`` or ``*`` for wildcards)."""
     for key, value in tree.items():
         if key == "ros__parameters":
-            yield "/".join(names), value
+            where = "/".join(names)
+            yield where, where.rsplit("/", 1)[-1], value
         elif isinstance(value, dict):
             yield from _parameter_sections(value, names + (str(key),))
 
@@ -192,15 +194,15 @@ class PipelineConfig:
         sections = list(_parameter_sections(values))
         if not sections:
             return cls.from_dict(values)
-        wildcard = [p for name, p in sections if name.rsplit("/", 1)[-1] in ("*", "**")]
-        named = [(name, p) for name, p in sections if name.rsplit("/", 1)[-1] not in ("*", "**")]
+        wildcard = [params for _, node, params in sections if node in ("*", "**")]
+        named = [(node, params) for _, node, params in sections if node not in ("*", "**")]
         if len(named) > 1:
-            named = [(name, p) for name, p in named if name.rsplit("/", 1)[-1] == node_name]
+            named = [(node, params) for node, params in named if node == node_name]
             if len(named) != 1:
                 raise ValueError(f"config {path} holds parameters of {len(sections)} nodes "
-                                 f"({', '.join(name for name, _ in sections)}) and not one named {node_name}")
+                                 f"({', '.join(where for where, _, _ in sections)}) and not one named {node_name}")
         merged: dict = {}
-        for params in wildcard + [p for _, p in named]:
+        for params in wildcard + [params for _, params in named]:
             if not isinstance(params, dict):
                 raise ValueError(f"config {path}: ros__parameters must be a mapping, got {params!r}")
             merged.update(params)
