@@ -42,12 +42,7 @@ def _qos(reliable: bool):
     return QoSProfile(depth=5, reliability=QoSReliabilityPolicy.RELIABLE) if reliable else qos_profile_sensor_data
 
 
-def _compressed(setup: str) -> bool:
-    """Whether the setup sends JPEG CompressedImage on ``image/compressed`` instead of raw images."""
-    return setup.endswith("-jpeg")
-
-
-def _add_echo(node, reliable: bool, compressed: bool = False) -> None:
+def _add_echo(node, reliable: bool, compressed: bool) -> None:
     """Make ``node`` answer every image (CompressedImage if ``compressed``, not decoded) with an empty
     Detection2DArray (header copied)."""
     from sensor_msgs.msg import CompressedImage, Image
@@ -92,7 +87,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
 
     env = dict(os.environ)             # the caller set FASTRTPS_DEFAULT_PROFILES_FILE for -shm
     box0 = [float(v) for v in seq.gt_boxes[0]]
-    compressed = _compressed(setup)
+    compressed = setup.endswith("-jpeg")  # JPEG CompressedImage on image/compressed
     params = {"initial_box": box0, "reliable_qos": args.reliable, "diagnostics_period_s": 0.2,
               "image_transport": "compressed" if compressed else "raw"}
     context = rclpy.Context()
