@@ -6,7 +6,7 @@ import cv2
 import numpy as np
 import pytest
 import yaml
-from helpers import PNG_SIGNATURE, REPO, run_module
+from helpers import PNG_SIGNATURE, REPO, cli_error, run_module
 
 from iemd_ros import TrackerConfig, evaluation
 from iemd_ros.evaluation import main, make_tracker, run_tracker, sequence_names
@@ -148,9 +148,7 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
     ],
 )
 def test_bad_arguments_exit_2_one_line(argv, match, capsys):
-    assert main(argv) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and err.startswith("iemd-eval: error:") and match in err
+    assert match in cli_error(main, argv, capsys, "iemd-eval: error:")
 
 
 def test_bad_argument_subprocess_no_traceback(tmp_path):

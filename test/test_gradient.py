@@ -1,4 +1,6 @@
 """Gradients of the EMD with respect to the window position (eqs. 9-10 and the envelope form)."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from helpers import shifted, texture
@@ -6,7 +8,7 @@ from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.boxes import box_centre
-from iemd_ros.candidate import CandidateModel, SearchContext
+from iemd_ros.candidate import CandidateModel
 from iemd_ros.emd import ground_distance, solve_emd, spatial_distance
 from iemd_ros.histogram import candidate_weights
 
@@ -21,9 +23,7 @@ def model_setup():
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
     center = box_centre(box)
-    context = SearchContext(ImagePyramid(to_gray(frame1)), tracker.layout, tracker._target, tracker.dictionary,
-                            tracker.config.alpha, tracker.config.kernel_bandwidth)
-    model = CandidateModel(context, center, np.array(box[2:], float))
+    model = CandidateModel(tracker._context(ImagePyramid(to_gray(frame1))), center, np.array(box[2:], float))
     return tracker, model
 
 
@@ -31,11 +31,9 @@ def test_candidate_at_is_the_same_model_at_another_window(model_setup):
     """CandidateModel.at (Algorithm 1's next iterate, a scale variant) keeps the frame, target,
     dictionary, pyramid level and orientation, and equals a model built at that window."""
     tracker, model = model_setup
-    pyramid, cfg = model.context.pyramid, tracker.config
 
-    def context(dictionary, coarse=0, angle=0.0):
-        return SearchContext(pyramid, tracker.layout, tracker._target, dictionary, cfg.alpha, cfg.kernel_bandwidth,
-                             coarse=coarse, angle=angle)
+    def context(dictionary, coarse=0, angle=0.0):  # a new context, with the fixture model's frame and target
+        return replace(model.context, dictionary=dictionary, coarse=coarse, angle=angle)
 
     turned = CandidateModel(context(None, coarse=1, angle=0.3), model.center, model.size)
     for start, dictionary in ((model, tracker.dictionary), (turned, None)):
