@@ -4,13 +4,14 @@ from __future__ import annotations
 import numpy as np
 
 from iemd_ros.bag_io import open_bag
-from iemd_ros.conversions import stamp_ns
+from iemd_ros.conversions import compressed_topic, stamp_ns
 from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_synthetic, write_bag
 from iemd_ros.synthetic import generate
 
 N_FRAMES = 12
 # the topics iemd-make-bag writes
 IMG, INFO, IMU = DEFAULT_TOPICS["image"], DEFAULT_TOPICS["camera_info"], DEFAULT_TOPICS["imu"]
+IMG_COMPRESSED = compressed_topic(IMG)  # where --compress writes the frames
 
 
 def shaky_sequence(n_frames: int = N_FRAMES, seed: int = 4, **over):

@@ -18,7 +18,8 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray
 
-from iemd_ros.conversions import array_to_compressed_fields, box_to_bbox, fill_bbox, fill_image_msg, ns_to_stamp
+from iemd_ros.conversions import (array_to_compressed_fields, box_to_bbox, compressed_topic, fill_bbox, fill_image_msg,
+                                  ns_to_stamp)
 
 FRAME_ID = "synthetic_cam"
 
@@ -92,7 +93,7 @@ class Driver:
         n = self.node
         self.compressed = compressed
         image_qos = QoSProfile(depth=10, reliability=rel)
-        self.image_pub = (n.create_publisher(CompressedImage, f"{image_topic}/compressed", image_qos) if compressed
+        self.image_pub = (n.create_publisher(CompressedImage, compressed_topic(image_topic), image_qos) if compressed
                           else n.create_publisher(Image, image_topic, image_qos))
         self.imu_pub = n.create_publisher(Imu, "imu", QoSProfile(depth=200, reliability=rel))
         self.info_pub = n.create_publisher(CameraInfo, "camera_info", QoSProfile(depth=10, reliability=rel))

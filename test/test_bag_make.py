@@ -6,7 +6,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from bag_fixtures import IMG, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
+from bag_fixtures import IMG, IMG_COMPRESSED, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
 from helpers import REPO, cli_error, run_module
 
 from iemd_ros.bag_io import custom_data, open_bag
@@ -26,7 +26,7 @@ JPEG_MEAN_ERROR = 4.0   # grey levels; measured at quality 95 on these frames: 3
 
 def _check_synthetic_bag(path, seq, encoding="bgr8", compress=None):
     msgs = read_all(path)
-    img_topic = IMG + "/compressed" if compress else IMG
+    img_topic = IMG_COMPRESSED if compress else IMG
     imgs, infos, imus = by_topic(msgs, img_topic), by_topic(msgs, INFO), by_topic(msgs, IMU)
     assert len(imgs) == len(infos) == len(seq.frames)
     np.testing.assert_array_equal(stamps(imgs), seq.frame_stamps_ns)      # camera clock
@@ -85,9 +85,9 @@ def test_synthetic_bag_formats(seq, tmp_path, fmt, name):
 def test_compressed_bags(seq, tmp_path, fmt, name, compress, encoding):
     """--compress: CompressedImage on IMAGE_TOPIC/compressed, camera info and IMU as in a raw bag."""
     info = make_bag(seq, tmp_path / name, fmt, encoding=encoding, compress=compress)
-    assert info["image_topic"] == IMG + "/compressed" and info["counts"][IMG + "/compressed"] == 8
+    assert info["image_topic"] == IMG_COMPRESSED and info["counts"][IMG_COMPRESSED] == 8
     msgs = _check_synthetic_bag(tmp_path / name, seq, encoding, compress)
-    assert {t: ty for t, ty, _, _ in msgs}[IMG + "/compressed"] == "sensor_msgs/msg/CompressedImage"
+    assert {t: ty for t, ty, _, _ in msgs}[IMG_COMPRESSED] == "sensor_msgs/msg/CompressedImage"
 
 
 def test_mono8_and_excerpt(seq, tmp_path):
@@ -178,6 +178,15 @@ def test_otb_folder(otb_root, tmp_path):
     np.testing.assert_allclose(parse_groundtruth(tmp_path / "gt.txt"), seq.gt_boxes[:5], atol=1e-9)
 
 
+def _three_frame_folder(seq, tmp_path) -> Path:
+    """An image folder (no stamps, IMU or calibration) with the first 3 frames of ``seq``."""
+    folder = tmp_path / "imgs"
+    folder.mkdir()
+    for k in range(3):
+        cv2.imwrite(str(folder / f"{k}.png"), seq.frames[k])
+    return folder
+
+
 def test_bad_input(seq, tmp_path, capsys):
     (tmp_path / "empty").mkdir()
     make_bag(seq, tmp_path / "exists")
@@ -190,10 +199,7 @@ def test_bad_input(seq, tmp_path, capsys):
     for argv, text in cases:
         assert text in cli_error(main, argv, capsys, "iemd-make-bag: error:")
     # output exists / count too large / ROS 1 path without .bag, through a real source
-    folder = tmp_path / "imgs"
-    folder.mkdir()
-    for k in range(3):
-        cv2.imwrite(str(folder / f"{k}.png"), seq.frames[k])
+    folder = _three_frame_folder(seq, tmp_path)
     for argv, text in [([str(folder), str(tmp_path / "exists")], "exists already"),
                        ([str(folder), str(tmp_path / "o4"), "--count", "5"], "exceeds the 3 frames"),
                        ([str(folder), str(tmp_path / "o5"), "--format", "ros1"], "must be a file ending in .bag"),
@@ -215,10 +221,7 @@ def test_bad_input(seq, tmp_path, capsys):
 
 def test_cli_compress_and_quality(seq, tmp_path, capsys):
     """--compress jpeg --jpeg-quality: lower quality, smaller frames; the summary names topic and codec."""
-    folder = tmp_path / "imgs"
-    folder.mkdir()
-    for k in range(3):
-        cv2.imwrite(str(folder / f"{k}.png"), seq.frames[k])
+    folder = _three_frame_folder(seq, tmp_path)
     sizes = {}
     for q in ("95", "50"):
         assert main([str(folder), str(tmp_path / f"q{q}"), "--compress", "jpeg", "--jpeg-quality", q,

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 import pytest
-from bag_fixtures import IMG, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence
+from bag_fixtures import IMG, IMG_COMPRESSED, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence
 from helpers import cli_error, detection_box
 
 rclpy = pytest.importorskip("rclpy")
@@ -51,7 +51,7 @@ class Recorder:
         n = self.node
         n.create_subscription(Image, IMG, lambda m: self._add("img", (time.monotonic(), stamp_ns(m.header),
                                                                      bytes(m.data), m.encoding)), q)
-        n.create_subscription(CompressedImage, IMG + "/compressed",
+        n.create_subscription(CompressedImage, IMG_COMPRESSED,
                               lambda m: self._add("compressed", (stamp_ns(m.header), m.format, bytes(m.data))), q)
         n.create_subscription(Imu, IMU, lambda m: self._add("imu", (stamp_ns(m.header), m.angular_velocity.x)), q)
         n.create_subscription(CameraInfo, INFO, lambda m: self._add("info", list(m.k)), q)
@@ -71,20 +71,25 @@ class Recorder:
         return False
 
 
-@pytest.mark.parametrize("fmt,name", [("mcap", "b"), ("ros1", "b.bag")])
-def test_play_contents_and_timing(ctx, seq, tmp_path, fmt, name):
-    make_bag(seq, tmp_path / name, fmt, imu_margin_s=0.1)
+def _play_recorded(ctx, bag, arrived, **play_kw):
+    """Play ``bag`` into a Recorder; wait until ``arrived(got, stats)`` holds; return (stats, got)."""
     rec = Recorder(ctx)
     player = rclpy.create_node("iemd_test_player", context=ctx)
     try:
         with spinning(ctx, rec.node):
-            stats = play(tmp_path / name, rate=2.0, wait_subscribers_s=10.0, node=player)
-            n_imu = stats.published[IMU]
-            assert rec.wait(lambda g: len(g["img"]) == len(seq.frames) and len(g["imu"]) == n_imu, 10.0)
+            stats = play(bag, wait_subscribers_s=10.0, node=player, **play_kw)
+            assert rec.wait(lambda g: arrived(g, stats), 10.0)
     finally:
         player.destroy_node()
         rec.node.destroy_node()
-    g = rec.got
+    return stats, rec.got
+
+
+@pytest.mark.parametrize("fmt,name", [("mcap", "b"), ("ros1", "b.bag")])
+def test_play_contents_and_timing(ctx, seq, tmp_path, fmt, name):
+    make_bag(seq, tmp_path / name, fmt, imu_margin_s=0.1)
+    stats, g = _play_recorded(ctx, tmp_path / name, lambda g, stats: len(g["img"]) == len(seq.frames)
+                              and len(g["imu"]) == stats.published[IMU], rate=2.0)
     assert stats.published[IMG] == stats.published[INFO] == len(seq.frames)
     assert [s for _, s, _, _ in g["img"]] == seq.frame_stamps_ns.tolist()
     for k, (_, _, data, enc) in enumerate(g["img"]):
@@ -105,19 +110,12 @@ def test_play_compressed(ctx, seq, tmp_path, fmt, name):
     """A CompressedImage topic goes out as sensor_msgs/CompressedImage with the bag's stamps, format and
     bytes (a ROS 1 bag through rosbags' converter)."""
     make_bag(seq, tmp_path / name, fmt, compress="jpeg", imu_margin_s=0.0)
-    topic = IMG + "/compressed"
+    topic = IMG_COMPRESSED
     want = [(stamp_ns(m.header), m.format, bytes(m.data)) for m in by_topic(read_all(tmp_path / name), topic)]
-    rec = Recorder(ctx)
-    player = rclpy.create_node("iemd_test_player", context=ctx)
-    try:
-        with spinning(ctx, rec.node):
-            stats = play(tmp_path / name, rate=4.0, topics=[topic, INFO], wait_subscribers_s=10.0, node=player)
-            assert rec.wait(lambda g: len(g["compressed"]) == len(seq.frames), 10.0)
-    finally:
-        player.destroy_node()
-        rec.node.destroy_node()
-    assert stats.published == {topic: len(seq.frames), INFO: len(seq.frames)} and rec.got["img"] == []
-    assert rec.got["compressed"] == want and want[0][1] == "bgr8; jpeg compressed bgr8"
+    stats, got = _play_recorded(ctx, tmp_path / name, lambda g, stats: len(g["compressed"]) == len(seq.frames),
+                                rate=4.0, topics=[topic, INFO])
+    assert stats.published == {topic: len(seq.frames), INFO: len(seq.frames)} and got["img"] == []
+    assert got["compressed"] == want and want[0][1] == "bgr8; jpeg compressed bgr8"
 
 
 def _live_vs_offline(ctx, bag, init, n_frames):

@@ -11,12 +11,11 @@ rclpy = pytest.importorskip("rclpy")
 pytest.importorskip("vision_msgs.msg")
 
 from rclpy.parameter import Parameter  # noqa: E402
-from iemd_ros.conversions import bbox_values  # noqa: E402
 from ros_harness import FRAME_ID, Driver, imu_msg, level, spinning, values  # noqa: E402
 
 from sensor_msgs.msg import Image  # noqa: E402
 
-from iemd_ros.conversions import image_from_msg, stamp_ns  # noqa: E402
+from iemd_ros.conversions import bbox_values, image_from_msg, stamp_ns  # noqa: E402
 from iemd_ros.boxes import box_centre  # noqa: E402
 from iemd_ros.node import TrackerNode  # noqa: E402
 from iemd_ros.synthetic import generate  # noqa: E402

@@ -10,7 +10,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-from bag_fixtures import IMG, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
+from bag_fixtures import IMG, IMG_COMPRESSED, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
 from helpers import REPO, cli_error, csv_boxes, detection_box, read_csv_rows, run_module
 
 from iemd_ros.bag_io import COMPRESSED_IMAGE_TYPE, IMAGE_TYPE, BagWriter
@@ -112,7 +112,7 @@ def test_jpeg_bag_tracks_like_raw_desk(imu_root, tmp_path):
     for codec in (None, "jpeg"):
         write_bag(src, tmp_path / str(codec), count=60, compress=codec)
         runs[codec] = replay(tmp_path / str(codec), src.gt_boxes[0])
-    assert runs["jpeg"].topics.image == IMG + "/compressed" and runs["jpeg"].gyro_used == runs[None].gyro_used == 59
+    assert runs["jpeg"].topics.image == IMG_COMPRESSED and runs["jpeg"].gyro_used == runs[None].gyro_used == 59
     agreement = iou(runs[None].boxes, runs["jpeg"].boxes)[1:]
     assert agreement.mean() > JPEG_MIN_MEAN_IOU, agreement
 
@@ -133,7 +133,7 @@ def test_formats_agree(seq, bags, tmp_path):
     for fmt, name, codec in (("sqlite3", "s", None), ("ros1", "r.bag", None), ("ros1", "rp.bag", "png")):
         make_bag(seq, tmp_path / name, fmt, compress=codec)
         res = replay(tmp_path / name, seq.gt_boxes[0])
-        assert res.topics.image == (f"{IMG}/compressed" if codec else IMG) and res.gyro_used == N - 1
+        assert res.topics.image == (IMG_COMPRESSED if codec else IMG) and res.gyro_used == N - 1
         np.testing.assert_array_equal(res.boxes, ref.boxes)
         assert [r.emd for r in res.results[1:]] == [r.emd for r in ref.results[1:]]
 
@@ -246,7 +246,7 @@ def test_raw_or_compressed_image_topic(seq, tmp_path, capsys):
 def test_corrupt_compressed_frame_is_counted(seq, tmp_path):
     """A compressed frame that does not decode is treated as a malformed raw Image: a ``malformed`` row
     without a box, counted in the summary and the diagnostics, tracking goes on; the real process exits 0."""
-    _bag_with(tmp_path / "cut", image_topics=(f"{IMG}/compressed",), seq=seq, bad_at=2, n=6)
+    _bag_with(tmp_path / "cut", image_topics=(IMG_COMPRESSED,), seq=seq, bad_at=2, n=6)
     out = run_module("iemd_ros.replay", str(tmp_path / "cut"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"),
                      "--out-bag", str(tmp_path / "res"))
     assert out.returncode == 0 and "Traceback" not in out.stderr, out.stderr
