@@ -74,6 +74,8 @@ _TRACKER_DOC = {
     "gradient": ("EMD gradient: appearance, envelope or paper (eq. 10)", None),
     "scale_step": ("relative scale variants tried at convergence, [0, 0.5)", (0.0, 0.499)),
     "scale_range": ("largest relative scale change per frame, [scale_step, 0.5)", (0.0, 0.499)),
+    "flow_start": ("also start where the window's median optical flow moved it (section 6.1)", None),
+    "flow_max_error": ("forward-backward error above which a flow point is dropped, px", (1e-3, 100.0)),
     "n_particles": ("extra starting points for abrupt motion (section 6.1)", (0, 64)),
     "particle_offset": ("distance of the extra starts from the prediction, window sizes", (0.0, 10.0)),
     "particle_trigger": ("run the extra starts when EMD > trigger x background EMD (0: always)", (0.0, 100.0)),

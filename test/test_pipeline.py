@@ -73,7 +73,9 @@ def test_tracks_synthetic_shake_with_gyro_and_is_deterministic(seq):
 
 
 def test_without_gyro_the_shake_is_not_followed_and_the_reason_is_given(seq):
-    p = _pipeline(seq, use_gyro=False)
+    # The tracker's own search only: its flow start follows much of the shake by itself (max centre
+    # error 0.5 px with it when written), which is not what this test is about.
+    p = _pipeline(seq, use_gyro=False, tracker={"flow_start": False})
     _feed_imu(p, seq)
     p.set_camera(seq.camera)
     res = _run(p, seq)

@@ -86,7 +86,7 @@ def test_prior_moves_the_start_of_the_search():
     frame0 = texture(seed=2)
     box = (130.0, 90.0, 40.0, 40.0)
     frame1 = shifted(frame0, 25.0, 0.0)
-    config = TrackerConfig(scale_step=0, n_particles=0, update_templates=False)
+    config = TrackerConfig(scale_step=0, n_particles=0, flow_start=False, update_templates=False)
     without = IemdTracker(config)
     without.init(frame0, box)
     with_prior = IemdTracker(config)
@@ -163,7 +163,7 @@ def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
     tracker.init(frame, (100.0, 80.0, 40.0, 40.0))
     solves.clear()
     result = tracker.update(shifted(frame, 3.0, 2.0))
-    assert result.starts == 1 + tracker.config.n_particles
+    assert result.starts == 2 + tracker.config.n_particles  # the prediction, the flow start, the particles
     assert result.solver_warnings == len(solves) > 0
 
 

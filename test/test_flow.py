@@ -1,0 +1,59 @@
+"""window_flow: the median optical flow of the target window, the tracker's flow start (section 6.1)."""
+import numpy as np
+import pytest
+from helpers import shifted, texture
+
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.appearance import grey_levels
+from iemd_ros.flow import window_flow
+from iemd_ros.otb import load_sequence, read_frame
+
+
+@pytest.fixture
+def car4(otb_root):
+    seq = load_sequence(otb_root / "Car4")
+    return grey_levels(read_frame(seq.frame_paths[0])), seq.gt_boxes[0]
+
+
+def translation(dx, dy):
+    return np.array([[1.0, 0.0, dx], [0.0, 1.0, dy], [0.0, 0.0, 1.0]])
+
+
+def test_finds_the_motion_of_a_real_window(car4):
+    frame, box = car4
+    flow = window_flow(frame, shifted(frame, 6.3, -4.2), box)
+    np.testing.assert_allclose(flow, [6.3, -4.2], atol=0.2)
+
+
+def test_a_prior_leaves_the_residual_motion_only(car4):
+    """The homography (the gyro prediction) seeds Lucas-Kanade: a 70 px motion it predicts up to
+    (1.5, -1) px leaves that residual."""
+    frame, box = car4
+    moved = shifted(frame, 71.5, -11.0)
+    np.testing.assert_allclose(window_flow(frame, moved, box, prior=translation(70.0, -10.0)), [1.5, -1.0],
+                               atol=0.2)
+
+
+def test_no_start_without_texture_or_inside_the_image():
+    flat = np.full((120, 160), 128, np.uint8)
+    assert window_flow(flat, flat, (40, 30, 40, 40)) is None
+    frame = texture(seed=3)
+    assert window_flow(frame, frame, (-30, -30, 33, 33)) is None  # 3x3 px of the window in the image
+    # Half outside: the part inside still gives the motion.
+    np.testing.assert_allclose(window_flow(frame, shifted(frame, 2.0, 1.0), (-20, 60, 60, 50)), [2.0, 1.0],
+                               atol=0.2)
+
+
+def test_the_flow_start_catches_a_jump_outside_the_convergence_region(car4):
+    """Car4 moved by 0.2 window sizes (22 px): without the particles only the flow start reaches it."""
+    frame, box = car4
+    jumped = shifted(frame, 22.0, 6.0)
+    config = TrackerConfig(scale_step=0, n_particles=0, update_templates=False)
+    results = {}
+    for flow_start in (True, False):
+        tracker = IemdTracker(TrackerConfig(**{**config.to_dict(), "flow_start": flow_start}))
+        tracker.init(frame, box)
+        results[flow_start] = tracker.update(jumped)
+    assert results[True].starts == 2 and results[False].starts == 1
+    assert np.allclose(results[True].box[:2], box[:2] + np.array([22.0, 6.0]), atol=1.0), results[True].box
+    assert not np.allclose(results[False].box[:2], box[:2] + np.array([22.0, 6.0]), atol=5.0), results[False].box
