@@ -29,9 +29,12 @@ def to_gray(frame: np.ndarray) -> np.ndarray:
     return np.multiply(grey_levels(frame), np.float32(1.0 / 255.0), dtype=np.float32)
 
 
-def grey_levels(frame: np.ndarray) -> np.ndarray:
-    """HxW uint8 grey levels of an HxW or HxWx3 (BGR) uint8 frame (the frame itself if grey)."""
-    return cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY) if frame.ndim == 3 else frame
+def grey_levels(frame: np.ndarray, copy: bool = False) -> np.ndarray:
+    """HxW uint8 grey levels of an HxW or HxWx3 (BGR) uint8 frame: the frame itself if grey, unless ``copy``
+    (a result to keep, which must not share the caller's buffer)."""
+    if frame.ndim == 3:
+        return cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    return frame.copy() if copy else frame
 
 
 def window_axes(angle: float) -> np.ndarray:

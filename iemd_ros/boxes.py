@@ -1,4 +1,5 @@
-"""Box ``(x, y, w, h)`` <-> centre and size, in pixel-index coordinates (ROS-free).
+"""Box ``(x, y, w, h)`` <-> centre and size, and points mapped by a homography, in pixel-index coordinates
+(ROS-free).
 
 A box covers pixels ``x .. x+w-1`` (0-based), i.e. the region ``[x-0.5, x+w-0.5]``; its centre is
 ``x + (w-1)/2`` (pixel centres at integers, as ``K``, OpenCV and the tracker).
@@ -7,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["box_centre", "centre_box", "check_box"]
+__all__ = ["box_centre", "centre_box", "check_box", "map_points"]
 
 
 def box_centre(box) -> np.ndarray:
@@ -37,3 +38,9 @@ def check_box(box, what: str = "box", shown=None) -> tuple[float, float, float, 
     if b[2] <= 0 or b[3] <= 0:
         raise ValueError(f"{what} must have a positive size (w, h > 0), got {shown!r}")
     return tuple(float(v) for v in b)
+
+
+def map_points(H, points) -> np.ndarray:
+    """(..., 2) pixel points mapped by the 3x3 homography ``H``."""
+    ph = np.asarray(points, dtype=float) @ H[:, :2].T + H[:, 2]
+    return ph[..., :2] / ph[..., 2:3]

@@ -14,6 +14,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
+from .boxes import map_points
+
 N_POINTS = 60  # corners followed per frame, at most
 MIN_POINTS = 4  # fewer surviving points give no start
 # Lucas-Kanade window and pyramid depth: motions up to about 5 * 2**3 = 40 px beyond the prediction.
@@ -35,7 +37,7 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     """
     x, y, w, h = (float(v) for v in box)
     corners = np.array([[x, y], [x + w, y], [x, y + h], [x + w, y + h]])
-    predicted = corners if prior is None else _transform(prior, corners)
+    predicted = corners if prior is None else map_points(prior, corners)
     margin = max(w, h)
     lo = np.floor(np.minimum(corners.min(0), predicted.min(0)) - margin).astype(int)
     hi = np.ceil(np.maximum(corners.max(0), predicted.max(0)) + margin).astype(int)
@@ -53,7 +55,7 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
         return None
     points += np.array([bx0 - x0, by0 - y0], dtype=np.float32)
     offset = np.array([x0, y0], dtype=np.float32)
-    guess = points if prior is None else (_transform(prior, points.reshape(-1, 2) + offset) - offset)
+    guess = points if prior is None else (map_points(prior, points.reshape(-1, 2) + offset) - offset)
     guess = np.ascontiguousarray(guess, dtype=np.float32).reshape(-1, 1, 2)
     moved, found, _ = cv2.calcOpticalFlowPyrLK(prev_roi, cur_roi, points, guess.copy(),
                                                flags=cv2.OPTFLOW_USE_INITIAL_FLOW, **_LK)
@@ -64,9 +66,3 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     if good.sum() < MIN_POINTS:
         return None
     return np.median((moved - guess).reshape(-1, 2)[good], axis=0).astype(np.float64)
-
-
-def _transform(H: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """(N, 2) points mapped by the homography ``H``."""
-    p = np.column_stack([points, np.ones(len(points))]) @ np.asarray(H, dtype=np.float64).T
-    return p[:, :2] / p[:, 2:3]

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .boxes import centre_box, check_box
+from .boxes import centre_box, check_box, map_points
 from .camera import CameraModel
 from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
 from .rotation import GyroCalibration, StillBiasEstimator
@@ -54,11 +54,6 @@ def rotation_homography(K, R, K_inv=None) -> np.ndarray:
     return H / H[2, 2]
 
 
-def _apply_h(H, p) -> np.ndarray:
-    ph = p @ H[:, :2].T + H[:, 2]
-    return ph[..., :2] / ph[..., 2:3]
-
-
 def warp_points(points, H, camera: CameraModel | None = None) -> np.ndarray:
     """Map raw-image points (..., 2) of frame k-1 to frame k: undistort -> ``H`` -> distort.
 
@@ -67,8 +62,8 @@ def warp_points(points, H, camera: CameraModel | None = None) -> np.ndarray:
     p = np.asarray(points, dtype=float)
     H = np.asarray(H, dtype=float)
     if camera is None or not camera.has_distortion:
-        return _apply_h(H, p)
-    return camera.distort_points(_apply_h(H, camera.undistort_points(p)))
+        return map_points(H, p)
+    return camera.distort_points(map_points(H, camera.undistort_points(p)))
 
 
 def box_grid(box) -> np.ndarray:
@@ -121,11 +116,11 @@ def _fit_prior(box, src, dst) -> tuple[np.ndarray, float]:
     G, _ = cv2.findHomography(src, dst, 0)
     if G is None:
         raise ValueError(f"could not fit a homography to the lens-aware mapping of box {np.asarray(box).tolist()}")
-    c_fit = _apply_h(G, src[-1])
+    c_fit = map_points(G, src[-1])
     T = np.array([[1.0, 0, dst[-1, 0] - c_fit[0]], [0, 1.0, dst[-1, 1] - c_fit[1]], [0, 0, 1.0]])
     G = T @ G
     G = G / G[2, 2]
-    res = float(np.max(np.hypot(*(_apply_h(G, src) - dst).T)))
+    res = float(np.max(np.hypot(*(map_points(G, src) - dst).T)))
     return G, res
 
 

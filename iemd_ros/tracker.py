@@ -174,9 +174,8 @@ class IemdTracker:
         self._center = box_centre((x, y, w, h))
         self._size = np.array([w, h], dtype=np.float64)
         self._angle = 0.0
-        grey = grey_levels(frame)
-        self._previous = grey if grey is not frame else grey.copy()
-        pyramid = ImagePyramid(to_gray(grey))
+        self._previous = grey_levels(frame, copy=True)
+        pyramid = ImagePyramid(to_gray(self._previous))
         template = pyramid.sample(self._center, self._size, cfg.template_size)
         self.dictionary = TemplateDictionary(self.layout, cfg.n_templates, cfg.lam,
                                              cfg.forgetting, cfg.reconstruction_lambda)
@@ -204,8 +203,8 @@ class IemdTracker:
             angle = _wrap_angle(angle + turn)
         self._frame_index += 1
         predicted = _box(center, size, angle)
-        grey, previous = grey_levels(frame), self._previous
-        self._previous = grey if grey is not frame else grey.copy()  # the caller may reuse its frame buffer
+        grey, previous = grey_levels(frame, copy=True), self._previous  # kept: the caller may reuse its buffer
+        self._previous = grey
         pyramid = ImagePyramid(to_gray(grey))
 
         flow_starts = []
