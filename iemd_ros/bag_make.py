@@ -57,7 +57,7 @@ from .bag_io import (CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, FORMATS, IMAGE_TYP
 from .camera import CameraModel
 from .cli import CliParser, cli_main
 from .conversions import (COMPRESSED_CODECS, JPEG_QUALITY, array_to_compressed_fields, check_compression,
-                          compressed_topic)
+                          compressed_topic, is_compressed_topic)
 from .otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
 from .recordings import seconds_to_ns, load_recording
 
@@ -285,7 +285,7 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
         raise ValueError(f"{source.name} has no ground truth to write to {gt_out}")
     tp = dict(DEFAULT_TOPICS, **(topics or {}))
     if compress is not None:
-        if tp["image"].rstrip("/").rpartition("/")[2] == "compressed":
+        if is_compressed_topic(tp["image"]):
             raise ValueError(f"--image-topic {tp['image']} ends in /compressed: give the raw topic, --compress "
                              "appends /compressed as image_transport does")
         tp["image"] = compressed_topic(tp["image"])

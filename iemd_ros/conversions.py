@@ -151,7 +151,7 @@ def _check_frame(frame) -> np.ndarray:
 def check_compression(codec: str, quality: int = JPEG_QUALITY) -> None:
     """ValueError unless ``codec`` is one of :data:`COMPRESSED_CODECS` and ``quality`` a JPEG quality 1-100."""
     if codec not in COMPRESSED_CODECS:
-        raise ValueError(f"codec must be 'jpeg' or 'png', got {codec!r}")
+        raise ValueError(f"codec must be {' or '.join(map(repr, COMPRESSED_CODECS))}, got {codec!r}")
     if not 1 <= int(quality) <= 100:
         raise ValueError(f"JPEG quality must be in [1, 100], got {quality}")
 
@@ -161,11 +161,16 @@ def compressed_topic(image_topic: str) -> str:
     return image_topic.rstrip("/") + "/compressed"
 
 
+def is_compressed_topic(topic: str) -> bool:
+    """True for a name whose last part is ``compressed`` (image_transport's compressed stream)."""
+    return topic.rstrip("/").rpartition("/")[2] == "compressed"
+
+
 def raw_twin(topic: str) -> str | None:
     """The image topic whose compressed stream ``topic`` is named as (inverse of :func:`compressed_topic`);
     None for a name that is not ``<image>/compressed``."""
-    head, _, last = topic.rstrip("/").rpartition("/")
-    return head if last == "compressed" and head else None
+    head = topic.rstrip("/").rpartition("/")[0]
+    return head if is_compressed_topic(topic) and head else None
 
 
 def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: int = JPEG_QUALITY) -> dict:

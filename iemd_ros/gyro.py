@@ -247,7 +247,7 @@ class GyroPredictor:
         :class:`~iemd_ros.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
         status = self.buffer.add(t_ns, w)
         if not self.bias_estimator.done:
-            good = status == SampleStatus.ACCEPTED
+            good = status == int(SampleStatus.ACCEPTED)  # an int: see imu._ACCEPTED
             if good.any() and self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
         return status

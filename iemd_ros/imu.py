@@ -48,8 +48,9 @@ class SampleStatus(IntEnum):
     SATURATED = 2                            # |w_i| >= saturation: rejected
 
 
-# The statuses as plain ints for ImuBuffer.add: numpy comparing an array with an IntEnum member
-# probes the enum class for array attributes, which doubled the cost of adding one IMU sample.
+# The statuses as plain ints for ImuBuffer.add (and GyroPredictor.add_imu compares with an int too): numpy
+# comparing an array with an IntEnum member probes the enum class for array attributes, which doubled the
+# cost of adding one IMU sample.
 _ACCEPTED, _NOT_FINITE, _SATURATED = (int(s) for s in SampleStatus)
 _NO_STAMP = np.iinfo(np.int64).min      # "no stamp yet" for the compiled screening: nothing is earlier
 

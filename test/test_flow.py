@@ -1,4 +1,6 @@
 """window_flow: the median optical flow of the target window, the tracker's flow start (section 6.1)."""
+import dataclasses
+
 import numpy as np
 import pytest
 from helpers import shifted, texture
@@ -51,7 +53,7 @@ def test_the_flow_start_catches_a_jump_outside_the_convergence_region(car4):
     config = TrackerConfig(scale_step=0, n_particles=0, update_templates=False)
     results = {}
     for flow_start in (True, False):
-        tracker = IemdTracker(TrackerConfig(**{**config.to_dict(), "flow_start": flow_start}))
+        tracker = IemdTracker(dataclasses.replace(config, flow_start=flow_start))
         tracker.init(frame, box)
         results[flow_start] = tracker.update(jumped)
     assert results[True].starts == 2 and results[False].starts == 1
