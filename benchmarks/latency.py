@@ -48,6 +48,8 @@ def _add_echo(node, reliable: bool, compressed: bool) -> None:
     from sensor_msgs.msg import CompressedImage, Image
     from vision_msgs.msg import Detection2DArray
 
+    from iemd_ros.conversions import compressed_topic
+
     pub = node.create_publisher(Detection2DArray, "detections", 10)
 
     def on_image(msg):
@@ -56,7 +58,7 @@ def _add_echo(node, reliable: bool, compressed: bool) -> None:
         pub.publish(out)
 
     if compressed:
-        node.create_subscription(CompressedImage, "image/compressed", on_image, _qos(reliable))
+        node.create_subscription(CompressedImage, compressed_topic("image"), on_image, _qos(reliable))
     else:
         node.create_subscription(Image, "image", on_image, _qos(reliable))
 
@@ -83,7 +85,8 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.conversions import array_to_compressed_fields, fill_image_msg, ns_to_stamp, stamp_ns
+    from iemd_ros.conversions import (array_to_compressed_fields, compressed_topic, fill_image_msg, ns_to_stamp,
+                                      stamp_ns)
 
     env = dict(os.environ)             # the caller set FASTRTPS_DEFAULT_PROFILES_FILE for -shm
     box0 = [float(v) for v in seq.gt_boxes[0]]
@@ -116,7 +119,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
 
         drv = rclpy.create_node("iemd_latency_driver", context=context)
         qos = _qos(args.reliable)
-        img_pub = (drv.create_publisher(CompressedImage, "image/compressed", qos) if compressed
+        img_pub = (drv.create_publisher(CompressedImage, compressed_topic("image"), qos) if compressed
                    else drv.create_publisher(Image, "image", qos))
         imu_pub = drv.create_publisher(Imu, "imu", QoSProfile(depth=200, reliability=qos.reliability))
         info_pub = drv.create_publisher(CameraInfo, "camera_info", qos)

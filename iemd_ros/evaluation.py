@@ -258,6 +258,11 @@ def build_parser() -> argparse.ArgumentParser:
 def collect_sequences(inputs: list[str], wanted: list[str] | None) -> list[Sequence]:
     """Load the sequences named by the CLI inputs (OTB roots, sequence folders or ``<folder>-<k>``
     targets), keeping those in ``wanted`` (case-insensitive; ``Jogging`` selects Jogging-1 and -2)."""
+    return [load_sequence(name, root) for name, root in _select_targets(inputs, wanted).items()]
+
+
+def _select_targets(inputs: list[str], wanted: list[str] | None) -> dict[str, Path]:
+    """The targets :func:`collect_sequences` loads, in order: name -> the root folder it lives in."""
     if not inputs:
         root = default_root()
         if root is None:
@@ -290,13 +295,13 @@ def collect_sequences(inputs: list[str], wanted: list[str] | None) -> list[Seque
             if not hits:
                 raise ValueError(f"unknown sequence {w!r} (available: {', '.join(found)})")
             selected.extend(h for h in hits if h not in selected)
-    return [load_sequence(name, found[name]) for name in selected]
+    return {name: found[name] for name in selected}
 
 
 def sequence_names(wanted: str | None) -> list[str]:
     """Names of the targets in ``../shared/data/otb`` chosen by a comma-separated list (as
     :func:`collect_sequences`; empty or None: all), for scripts whose workers load them by name."""
-    return [seq.name for seq in collect_sequences([], wanted.split(",") if wanted else None)]
+    return list(_select_targets([], wanted.split(",") if wanted else None))
 
 
 def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, configs=None) -> dict:

@@ -29,12 +29,14 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     """Median motion (dx, dy) in px of the content of ``box`` from ``previous`` into ``current``
     beyond what ``prior`` predicts, or None when too few points can be followed.
 
-    ``previous``, ``current``: HxW uint8 grey frames of one size; ``box`` = (x, y, w, h) in
+    ``previous``, ``current``: HxW uint8 grey frames (None if their sizes differ); ``box`` = (x, y, w, h) in
     ``previous``; ``prior``: the 3x3 homography from ``previous`` into ``current`` pixels (the gyro
     prediction), which seeds the Lucas-Kanade search.  The window's predicted centre plus the
     returned residual is the flow's starting point.  Only a region around the window and its
     prediction is processed (one window size of margin), so the cost does not grow with the frame.
     """
+    if previous.shape != current.shape:
+        return None
     x, y, w, h = (float(v) for v in box)
     corners = np.array([[x, y], [x + w, y], [x, y + h], [x + w, y + h]])
     predicted = corners if prior is None else map_points(prior, corners)

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from .appearance import grey_levels
 from .boxes import centre_box, check_box, map_points
 from .camera import CameraModel
 from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
@@ -138,11 +139,7 @@ def warp_difference(frame_prev, frame_cur, H, valid=None, erode: int = 5) -> flo
     an optional boolean mask of defined pixels (e.g. after undistortion), shared by both frames.  Only
     pixels defined in both (eroded by ``erode`` px against interpolation at the borders) count.
     """
-    a, b = (np.asarray(f) for f in (frame_prev, frame_cur))
-    if a.ndim == 3:
-        a = cv2.cvtColor(a, cv2.COLOR_BGR2GRAY)
-    if b.ndim == 3:
-        b = cv2.cvtColor(b, cv2.COLOR_BGR2GRAY)
+    a, b = (grey_levels(np.asarray(f)) for f in (frame_prev, frame_cur))
     if a.shape != b.shape:
         raise ValueError(f"frames differ in size: {a.shape} vs {b.shape}")
     h, w = a.shape

@@ -208,7 +208,7 @@ class IemdTracker:
         pyramid = ImagePyramid(to_gray(grey))
 
         flow_starts = []
-        if cfg.flow_start and grey.shape == previous.shape:
+        if cfg.flow_start:
             flow = window_flow(previous, grey, _box(self._center, self._size, self._angle), prior, cfg.flow_max_error)
             if flow is not None and np.linalg.norm(flow) >= cfg.min_step_px:  # else it is the same start
                 flow_starts.append(center + flow)
@@ -317,14 +317,14 @@ class IemdTracker:
         """
         fine = self._context(pyramid, angle)
         coarse = self._context(pyramid, angle, coarse=True) if self.config.coarse_to_fine else None
-        scored, warnings = [], 0
-        for start, wide in [(s, True) for s in starts] + [(s, False) for s in fine_starts]:
-            if coarse is not None and wide:
+        ends, warnings = [], 0
+        for start in starts:
+            if coarse is not None:
                 first = CandidateModel(coarse, start, size)
                 stage = self._descend(first)
                 start, warnings = stage.center, warnings + stage.warnings + _not_optimal(first.emd()[1])
-            model = CandidateModel(fine, start, size)
-            scored.append((*model.emd(), model))
+            ends.append(start)
+        scored = [(*model.emd(), model) for model in (CandidateModel(fine, s, size) for s in [*ends, *fine_starts])]
         best = self._descend(min(scored, key=lambda item: item[0])[2])  # the winner's EMD is cached
         best.codings += len(scored)
         best.warnings += warnings + sum(_not_optimal(sol) for _, sol, _ in scored)
