@@ -219,7 +219,7 @@ def test_configure_validates_and_restarts_the_tracker(seq):
     p, s = _started(seq)
     r1 = p.process(seq.frames[1], s[1])
     stored = p.diagnostics()["imu_stored"]
-    new = PipelineConfig(tracker=TrackerConfig(n_particles=0), gyro=p.config.gyro)
+    new = PipelineConfig(tracker=TrackerConfig(n_particles=4), gyro=p.config.gyro)
     assert "restarted" in p.configure(new)
     assert p.state == "tracking" and p.diagnostics()["imu_stored"] == stored
     gyro2 = PipelineConfig(tracker=new.tracker, gyro=GyroConfig(time_offset_ns=seq.time_offset_ns, max_gap_ns=10**8))

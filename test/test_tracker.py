@@ -159,12 +159,31 @@ def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
 
     monkeypatch.setattr(candidate, "solve_emd", non_optimal)
     frame = texture(seed=5)
-    tracker = IemdTracker(TrackerConfig(particle_trigger=0.0))  # the particles run on every frame
+    tracker = IemdTracker(TrackerConfig(n_particles=4, particle_trigger=0.0))  # the particles run on every frame
     tracker.init(frame, (100.0, 80.0, 40.0, 40.0))
     solves.clear()
     result = tracker.update(shifted(frame, 3.0, 2.0))
     assert result.starts == 2 + tracker.config.n_particles  # the prediction, the flow start, the particles
     assert result.solver_warnings == len(solves) > 0
+
+
+def test_the_particles_catch_a_jump_of_half_a_window(otb_root):
+    """Section 6.1's particles (off by default, see TrackerConfig): Car4 moved by 0.45 window sizes, with
+    no flow start, is reached from the particle 0.5 window sizes to the right and missed without them."""
+    seq = load_sequence(otb_root / "Car4")
+    frame, box = read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0])
+    jump = np.array([0.45 * box[2], 0.03 * box[3]])
+    moved = shifted(frame, *jump)
+    config = TrackerConfig(scale_step=0, flow_start=False, particle_trigger=0.0, update_templates=False)
+    boxes = {}
+    for n_particles in (0, 4):
+        tracker = IemdTracker(dataclasses.replace(config, n_particles=n_particles))
+        tracker.init(frame, box)
+        result = tracker.update(moved)
+        assert result.starts == 1 + n_particles
+        boxes[n_particles] = np.asarray(result.box[:2])
+    assert np.allclose(boxes[4], box[:2] + jump, atol=1.0), boxes[4]
+    assert not np.allclose(boxes[0], box[:2] + jump, atol=5.0), boxes[0]
 
 
 def test_visible_fraction_of_a_turned_window():
