@@ -90,6 +90,7 @@ def gyro_config_to_dict(cfg: GyroConfig) -> dict:
 
 
 NODE_NAME = "iemd_tracker"  # the tracker node's default name (iemd_ros.node), as parameter files name it
+_WILDCARD_NODES = ("*", "**")  # node names of a parameter file's sections that apply to every node
 
 
 def _parameter_sections(tree: dict, names: tuple = ()):
@@ -194,8 +195,8 @@ class PipelineConfig:
         sections = list(_parameter_sections(values))
         if not sections:
             return cls.from_dict(values)
-        wildcard = [params for _, node, params in sections if node in ("*", "**")]
-        named = [(node, params) for _, node, params in sections if node not in ("*", "**")]
+        wildcard = [params for _, node, params in sections if node in _WILDCARD_NODES]
+        named = [(node, params) for _, node, params in sections if node not in _WILDCARD_NODES]
         if len(named) > 1:
             named = [(node, params) for node, params in named if node == node_name]
             if len(named) != 1:
