@@ -37,7 +37,7 @@ __all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CA
 
 IMAGE_TYPE = "sensor_msgs/msg/Image"
 COMPRESSED_IMAGE_TYPE = "sensor_msgs/msg/CompressedImage"
-#: types an image topic may have, in the order auto-detection prefers them (raw is lossless)
+#: types an image topic may have
 IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
 IMU_TYPE = "sensor_msgs/msg/Imu"
 CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"

@@ -25,7 +25,8 @@ from .camera import CameraModel
 from .boxes import box_centre, centre_box, check_box
 
 __all__ = ["ENCODINGS", "COMPRESSED_CODECS", "JPEG_QUALITY", "image_to_array", "compressed_to_array",
-           "array_to_image_fields", "array_to_compressed_fields", "check_compression", "compressed_topic", "raw_twin", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
+           "array_to_image_fields", "array_to_compressed_fields", "check_compression", "compressed_topic",
+           "is_compressed_topic", "raw_twin", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
            "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
            "bbox_values", "fill_bbox",
            "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]

@@ -19,8 +19,9 @@ from .boxes import map_points
 N_POINTS = 60  # corners followed per frame, at most
 MIN_POINTS = 4  # fewer surviving points give no start
 # Lucas-Kanade window and pyramid depth: motions up to about 5 * 2**3 = 40 px beyond the prediction.
-# 11x11 was measured at 28.7 % (12 sequences x 5 starts, see TrackerConfig.flow_start) against 28.0 % for
-# 15x15, at 0.6-0.8 ms against 0.8-1.3 ms per frame.
+# 11x11 was measured at 28.7 % (12 sequences x 5 starts, particles on, the flow start sent through the
+# coarse stage as well; see TrackerConfig.flow_start) against 28.0 % for 15x15, at 0.6-0.8 ms against
+# 0.8-1.3 ms per frame.
 _LK = dict(winSize=(11, 11), maxLevel=3)
 
 
@@ -29,8 +30,8 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     """Median motion (dx, dy) in px of the content of ``box`` from ``previous`` into ``current``
     beyond what ``prior`` predicts, or None when too few points can be followed.
 
-    ``previous``, ``current``: HxW uint8 grey frames (None if their sizes differ); ``box`` = (x, y, w, h) in
-    ``previous``; ``prior``: the 3x3 homography from ``previous`` into ``current`` pixels (the gyro
+    ``previous``, ``current``: HxW uint8 grey frames (frames of different sizes give None); ``box`` =
+    (x, y, w, h) in ``previous``; ``prior``: the 3x3 homography from ``previous`` into ``current`` pixels (the gyro
     prediction), which seeds the Lucas-Kanade search.  The window's predicted centre plus the
     returned residual is the flow's starting point.  Only a region around the window and its
     prediction is processed (one window size of margin), so the cost does not grow with the frame.
@@ -45,10 +46,8 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     hi = np.ceil(np.maximum(corners.max(0), predicted.max(0)) + margin).astype(int)
     x0, y0 = np.maximum(lo, 0)
     x1, y1 = np.minimum(hi, [previous.shape[1], previous.shape[0]])
-    if x1 - x0 < 8 or y1 - y0 < 8:
-        return None
-    prev_roi, cur_roi = previous[y0:y1, x0:x1], current[y0:y1, x0:x1]
-    bx0, by0 = max(int(np.floor(x)), 0), max(int(np.floor(y)), 0)  # corners are searched in the window only
+    # Corners are searched in the window only; it lies inside the region, so its size check covers both.
+    bx0, by0 = max(int(np.floor(x)), 0), max(int(np.floor(y)), 0)
     window = previous[by0:max(int(np.ceil(y + h)), by0), bx0:max(int(np.ceil(x + w)), bx0)]
     if min(window.shape) < 8:
         return None
@@ -59,6 +58,7 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     offset = np.array([x0, y0], dtype=np.float32)
     guess = points if prior is None else (map_points(prior, points.reshape(-1, 2) + offset) - offset)
     guess = np.ascontiguousarray(guess, dtype=np.float32).reshape(-1, 1, 2)
+    prev_roi, cur_roi = previous[y0:y1, x0:x1], current[y0:y1, x0:x1]
     moved, found, _ = cv2.calcOpticalFlowPyrLK(prev_roi, cur_roi, points, guess.copy(),
                                                flags=cv2.OPTFLOW_USE_INITIAL_FLOW, **_LK)
     back, found_back, _ = cv2.calcOpticalFlowPyrLK(cur_roi, prev_roi, moved, points.copy(),

@@ -35,7 +35,7 @@ import numpy as np
 from .appearance import grey_levels
 from .boxes import centre_box, check_box, map_points
 from .camera import CameraModel
-from .imu import Coverage, ImuBuffer, ImuIntegration, SampleStatus
+from .imu import ACCEPTED_STATUS, Coverage, ImuBuffer, ImuIntegration
 from .rotation import GyroCalibration, StillBiasEstimator
 
 __all__ = ["rotation_homography", "warp_points", "box_grid", "local_prior", "predict_box",
@@ -244,7 +244,7 @@ class GyroPredictor:
         :class:`~iemd_ros.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
         status = self.buffer.add(t_ns, w)
         if not self.bias_estimator.done:
-            good = status == int(SampleStatus.ACCEPTED)  # an int: see imu._ACCEPTED
+            good = status == ACCEPTED_STATUS
             if good.any() and self.bias_estimator.update(np.atleast_2d(np.asarray(w, dtype=float))[good]):
                 self._cal = GyroCalibration(self._cal.R_cam_imu, self.bias_estimator.bias)
         return status

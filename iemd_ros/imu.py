@@ -48,10 +48,9 @@ class SampleStatus(IntEnum):
     SATURATED = 2                            # |w_i| >= saturation: rejected
 
 
-# The statuses as plain ints for ImuBuffer.add (and GyroPredictor.add_imu compares with an int too): numpy
-# comparing an array with an IntEnum member probes the enum class for array attributes, which doubled the
-# cost of adding one IMU sample.
-_ACCEPTED, _NOT_FINITE, _SATURATED = (int(s) for s in SampleStatus)
+# The statuses as plain ints for ImuBuffer.add and GyroPredictor.add_imu: numpy comparing an array with an
+# IntEnum member probes the enum class for array attributes, which doubled the cost of adding one IMU sample.
+ACCEPTED_STATUS, _NOT_FINITE, _SATURATED = (int(s) for s in SampleStatus)
 _NO_STAMP = np.iinfo(np.int64).min      # "no stamp yet" for the compiled screening: nothing is earlier
 
 
@@ -161,7 +160,7 @@ class ImuBuffer:
             if nan or saturated:
                 c["nan"] += nan
                 c["saturated"] += saturated
-                keep = status == _ACCEPTED
+                keep = status == ACCEPTED_STATUS
                 t, w = t[keep], w[keep]
             if len(t) == 0:
                 return status
@@ -334,7 +333,7 @@ def _screen(t, w, saturation, t_max, t_integrated, status):
             status[i] = _SATURATED
             saturated += 1
         else:
-            status[i] = _ACCEPTED
+            status[i] = ACCEPTED_STATUS
             if t[i] < t_max:
                 out_of_order += 1
             else:

@@ -181,8 +181,10 @@ class PipelineConfig:
         """From a YAML file: either ``{tracker: {...}, gyro: {...}, use_gyro: ..., imu_wait_ms: ...}``
         (:meth:`from_dict`) or a ROS parameter file (``config/tracker.yaml``), read as the node named
         ``node_name`` would: the ``ros__parameters`` of wildcard sections (``/**``) and then of its
-        own section (its name, optionally under namespaces), by :meth:`from_parameters`.  ValueError
-        for a file that cannot be read, has no section for the node, or holds invalid values."""
+        own section (optionally under namespaces), by :meth:`from_parameters`.  A file with one named
+        section is read whatever that name (a renamed node's file); of several, the one named ``node_name``.
+        ValueError for a file that cannot be read, has several named sections and none for the node, or
+        holds invalid values."""
         import yaml  # noqa: PLC0415 - only the command-line tools read configuration files
 
         path = Path(path)

@@ -6,8 +6,9 @@
 
 ``BAG``: a rosbag2 folder (sqlite3 or mcap) or a ROS 1 ``.bag`` file (rosbags' AnyReader).  The image,
 IMU and camera-info topics are auto-detected when the bag has one of each type, else named.  Images are
-``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage`` (jpeg/png, e.g. ``image_raw/compressed``); a raw
-topic is preferred over a compressed one (:func:`iemd_ros.bag_io.select_topics`).  The messages go, in
+``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage`` (jpeg/png, e.g. ``image_raw/compressed``); a
+compressed topic is left out when its own raw twin (``image_raw`` for ``image_raw/compressed``) holds
+messages (:func:`iemd_ros.bag_io.select_topics`).  The messages go, in
 the bag's (log-time) order, through :class:`iemd_ros.pipeline.TrackingPipeline` -- the same
 synchronization, gyro prediction and tracker as the node -- deterministically: nothing depends on the
 wall clock, so the same bag gives the same CSV byte for byte.
@@ -415,8 +416,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("bag", help="rosbag2 folder (sqlite3/mcap) or ROS 1 .bag file")
     p.add_argument("--init", required=True, type=str, metavar="X,Y,W,H",
                    help="initial box on the first image (0-based pixels, top-left + size)")
-    p.add_argument("--image-topic", default=None, help="sensor_msgs/Image or CompressedImage topic "
-                                                        "(default: the bag's one raw, else its one compressed)")
+    p.add_argument("--image-topic", default=None, help="sensor_msgs/Image or CompressedImage topic (default: the "
+                                                        "bag's one image topic; X/compressed yields to its raw X)")
     p.add_argument("--imu-topic", default=None)
     p.add_argument("--camera-info-topic", default=None)
     p.add_argument("--no-gyro", action="store_true", help="track without the gyro prior")

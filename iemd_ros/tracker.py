@@ -45,11 +45,13 @@ class TrackerConfig:
     scale_range: float = 0.02  # largest relative scale change searched per frame, in scale_step steps (gyro run: 0.1)
     # Section 6.1's extra starts.  First the window's median optical flow (iemd_ros/flow.py), refined at full
     # resolution only.  Measured over the 12 OTB sequences from the ground truth and from it shifted by 10 % along
-    # the 4 diagonals (60 runs): mean average overlap 26.1 % against 22.2 % without (per start 30.5/27.0/24.0/
-    # 23.7/25.5 vs 31.9/19.2/23.5/13.5/22.9 %).  Through the coarse stage too it scored 28.7 % (28.0 % with a
-    # 15x15 Lucas-Kanade window, 25.7 % at flow_max_error 2 px) but took the pooled median update of
-    # benchmarks/bench_speed.py from 8.3 to 10.2 ms.  As the only start (none at the prediction) a prototype
-    # scored 27.0 % vs 35.4 % from the ground truth: the flow follows occluders too, the EMD has to choose.
+    # the 4 diagonals (60 runs), with the defaults (particles off): mean average overlap 34.1 % against 20.8 %
+    # without it.  The figures that follow were measured with the particles on: 26.1 % against 22.2 % without
+    # (per start 30.5/27.0/24.0/23.7/25.5 vs 31.9/19.2/23.5/13.5/22.9 %).  Through the coarse stage too it
+    # scored 28.7 % (28.0 % with a 15x15 Lucas-Kanade window, 25.7 % at flow_max_error 2 px) but took the pooled
+    # median update of benchmarks/bench_speed.py from 8.3 to 10.2 ms.  As the only start (none at the
+    # prediction) a prototype scored 27.0 % vs 35.4 % from the ground truth: the flow follows occluders too,
+    # the EMD has to choose.  (Particles off: the flow start alone 30.2 %, through the coarse stage 31.4 %.)
     flow_start: bool = True
     flow_max_error: float = 1.0  # forward-backward error (px) above which a flow point is dropped
     # Then section 6.1's particles, n_particles windows particle_offset window sizes around the prediction.  Off
@@ -57,7 +59,8 @@ class TrackerConfig:
     # 26.1 % (per start 40.5/32.0/38.7/30.0/29.5 % without them), 30.5-31.0 % when they run only on lost frames
     # (trigger 100 or 1.0).  A window half a window off, on part of the target, often has a lower EMD than the
     # target under a change of appearance: on Woman (frame 116) and Bolt2 (frame 20) the particles took such a
-    # jump and the tracker never came back.  (Before the flow start: 26.7 % without, 27.0 % at offset 0.25.)
+    # jump and the tracker never came back.  (Before the flow start, one run from the ground truth: 26.7 %
+    # without, 27.0 % at offset 0.25.)
     n_particles: int = 0
     particle_offset: float = 0.5  # their distance from the prediction, in window sizes
     # Thresholds relative to the background EMD; measured EMD/background while tracking
@@ -106,6 +109,9 @@ class TrackerConfig:
 
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+_COARSE_LEVELS = 1  # pyramid levels above the fine one at which the coarse stage samples
 
 
 @dataclass
@@ -178,8 +184,8 @@ class IemdTracker:
         self._center = box_centre((x, y, w, h))
         self._size = np.array([w, h], dtype=np.float64)
         self._angle = 0.0
-        self._previous = grey_levels(frame, copy=True)
-        pyramid = ImagePyramid(to_gray(self._previous))
+        self._previous = None
+        _, _, pyramid = self._take_frame(frame)
         template = pyramid.sample(self._center, self._size, cfg.template_size)
         self.dictionary = TemplateDictionary(self.layout, cfg.n_templates, cfg.lam,
                                              cfg.forgetting, cfg.reconstruction_lambda)
@@ -188,7 +194,8 @@ class IemdTracker:
         self._refresh_target()
         self._background_emd = self._measure_background_emd(pyramid)
         # Coarse stage: the target window one pyramid level smoother, weighted by the kernel only.
-        coarse_eps = self.layout.extract(pyramid.sample(self._center, self._size, cfg.template_size, coarse=1))
+        coarse_eps = self.layout.extract(pyramid.sample(self._center, self._size, cfg.template_size,
+                                                        coarse=_COARSE_LEVELS))
         self._coarse_target = TargetModel.from_patches(self.layout.positions(), coarse_eps, np.ones(len(coarse_eps)),
                                                        cfg.kernel_bandwidth)
         self._frame_index = 0
@@ -207,14 +214,12 @@ class IemdTracker:
             angle = _wrap_angle(angle + turn)
         self._frame_index += 1
         predicted = _box(center, size, angle)
-        grey, previous = grey_levels(frame, copy=True), self._previous  # kept: the caller may reuse its buffer
-        self._previous = grey
-        pyramid = ImagePyramid(to_gray(grey))
+        previous, grey, pyramid = self._take_frame(frame)
 
         flow_starts = []
         if cfg.flow_start:
             flow = window_flow(previous, grey, _box(self._center, self._size, self._angle), prior, cfg.flow_max_error)
-            if flow is not None and np.linalg.norm(flow) >= cfg.min_step_px:  # else it is the same start
+            if flow is not None and np.linalg.norm(flow) >= cfg.min_step_px:  # closer: the descent's own start
                 flow_starts.append(center + flow)
         best = self._search(pyramid, center[None], size, angle, flow_starts)
         searches = [best]
@@ -253,6 +258,15 @@ class IemdTracker:
         )
 
     # ------------------------------------------------------------ internals
+    def _take_frame(self, frame: np.ndarray):
+        """(grey levels kept from the previous frame, ``frame``'s grey levels, its pyramid).  With the flow
+        start the grey levels are kept for the next frame, copied (the caller may reuse its buffer);
+        without it nothing is kept (None)."""
+        keep = self.config.flow_start
+        grey = grey_levels(frame, copy=keep)
+        previous, self._previous = self._previous, (grey if keep else None)
+        return previous, grey, ImagePyramid(to_gray(grey))
+
     def _measure_background_emd(self, pyramid: ImagePyramid) -> float:
         """Median EMD between the target and the four windows one window size away in I_0.
 
@@ -288,7 +302,7 @@ class IemdTracker:
         cfg = self.config
         if coarse:
             return SearchContext(pyramid, self.layout, self._coarse_target, None, cfg.alpha, cfg.kernel_bandwidth,
-                                 coarse=1, angle=angle)
+                                 coarse=_COARSE_LEVELS, angle=angle)
         return SearchContext(pyramid, self.layout, self._target, self.dictionary, cfg.alpha, cfg.kernel_bandwidth,
                              angle=angle)
 
@@ -328,10 +342,10 @@ class IemdTracker:
                 stage = self._descend(first)
                 start, warnings = stage.center, warnings + stage.warnings + _not_optimal(first.emd()[1])
             ends.append(start)
-        scored = [(*model.emd(), model) for model in (CandidateModel(fine, s, size) for s in [*ends, *fine_starts])]
-        best = self._descend(min(scored, key=lambda item: item[0])[2])  # the winner's EMD is cached
-        best.codings += len(scored)
-        best.warnings += warnings + sum(_not_optimal(sol) for _, sol, _ in scored)
+        models = [CandidateModel(fine, s, size) for s in (*ends, *fine_starts)]
+        best = self._descend(min(models, key=lambda model: model.emd()[0]))  # each model caches its EMD
+        best.codings += len(models)
+        best.warnings += warnings + sum(_not_optimal(model.emd()[1]) for model in models)
         return best
 
     def _descend(self, model: CandidateModel) -> _Descent:
@@ -346,7 +360,7 @@ class IemdTracker:
         cfg = self.config
         half = model.size / 2.0
         axes = window_axes(model.angle)
-        emd, grad, _ = model.evaluate(cfg.gradient)  # a particle winner's EMD is already solved
+        emd, grad, _ = model.evaluate(cfg.gradient)  # cached for _search's winners; a coarse start's is solved here
         state = _Descent(model=model, emd=emd)  # its solve is counted by the caller, with its coding
         # A coarse stage samples ``coarse`` pyramid levels up: its steps are that much longer.
         level_scale = 2.0 ** model.coarse

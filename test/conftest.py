@@ -3,6 +3,7 @@ import signal
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
@@ -19,6 +20,15 @@ def _need(path: Path) -> Path:
 def otb_root() -> Path:
     """Folder of OTB sequences (../shared/data/otb)."""
     return _need(DATA / "otb")
+
+
+@pytest.fixture
+def car4_first(otb_root):
+    """Car4's first frame (BGR) and its ground-truth box (x, y, w, h), the real texture of several tests."""
+    from iemd_ros.otb import load_sequence, read_frame
+
+    seq = load_sequence(otb_root / "Car4")
+    return read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0], dtype=float)
 
 
 @pytest.fixture

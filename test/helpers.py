@@ -63,6 +63,17 @@ def run_module(module: str, *args: str, timeout: float = 120, **kw) -> subproces
                           env={**os.environ, "PYTHONPATH": str(REPO)}, **kw)
 
 
+def node_parameter_file(path: Path, **ros_parameters) -> Path:
+    """config/tracker.yaml (the node's parameter file) with ``ros_parameters`` set in its node section,
+    written to ``path``."""
+    import yaml  # noqa: PLC0415 - only the parameter-file tests need it
+
+    params = yaml.safe_load((REPO / "config" / "tracker.yaml").read_text())
+    params[next(iter(params))]["ros__parameters"].update(ros_parameters)
+    path.write_text(yaml.safe_dump(params))
+    return path
+
+
 def read_csv_rows(path) -> list[list[str]]:
     with open(path, newline="") as f:
         return list(csv.reader(f))

@@ -5,8 +5,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
-import yaml
-from helpers import PNG_SIGNATURE, REPO, cli_error, run_module
+from helpers import PNG_SIGNATURE, cli_error, node_parameter_file, run_module
 
 from iemd_ros import TrackerConfig, evaluation
 from iemd_ros.evaluation import main, make_tracker, run_tracker, sequence_names
@@ -118,10 +117,7 @@ def test_cli_real_excerpt_csrt_kcf(otb_root, tmp_path, capsys):
 
 def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
     """--config takes the node's config/tracker.yaml; its tracker.* values are the ones iEMD runs with."""
-    params = yaml.safe_load((REPO / "config" / "tracker.yaml").read_text())
-    node = next(iter(params))
-    params[node]["ros__parameters"]["tracker"] = {"scale_step": 0.0}
-    (tmp_path / "p.yaml").write_text(yaml.safe_dump(params))
+    node_parameter_file(tmp_path / "p.yaml", tracker={"scale_step": 0.0})
     common = [str(otb_root), "--trackers", "iemd", "--sequences", "Car4", "--max-frames", "40"]
     assert main(common + ["--out", str(tmp_path / "default")]) == 0
     assert main(common + ["--out", str(tmp_path / "fixed"), "--config", str(tmp_path / "p.yaml")]) == 0

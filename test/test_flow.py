@@ -8,13 +8,12 @@ from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import grey_levels
 from iemd_ros.flow import window_flow
-from iemd_ros.otb import load_sequence, read_frame
 
 
 @pytest.fixture
-def car4(otb_root):
-    seq = load_sequence(otb_root / "Car4")
-    return grey_levels(read_frame(seq.frame_paths[0])), seq.gt_boxes[0]
+def car4(car4_first):
+    frame, box = car4_first
+    return grey_levels(frame), box
 
 
 def translation(dx, dy):

@@ -11,7 +11,7 @@ import cv2
 import numpy as np
 import pytest
 from bag_fixtures import IMG, IMG_COMPRESSED, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
-from helpers import REPO, cli_error, csv_boxes, detection_box, read_csv_rows, run_module
+from helpers import cli_error, csv_boxes, detection_box, node_parameter_file, read_csv_rows, run_module
 
 from iemd_ros.bag_io import COMPRESSED_IMAGE_TYPE, IMAGE_TYPE, BagWriter
 from iemd_ros.bag_make import (_camera_info_msg, _compressed_msg, _image_msg, _imu_msg, source_from_folder,
@@ -312,18 +312,12 @@ def test_cli_process_no_traceback(seq, tmp_path):
 
 def test_node_parameter_file_as_config(seq, bags, tmp_path):
     """--config takes the node's parameter file (config/tracker.yaml); its pipeline keys apply."""
-    import yaml
-
-    params = yaml.safe_load((REPO / "config" / "tracker.yaml").read_text())
-    node = next(iter(params))
-    params[node]["ros__parameters"]["use_gyro"] = False
-    (tmp_path / "p.yaml").write_text(yaml.safe_dump(params))
+    node_parameter_file(tmp_path / "p.yaml", use_gyro=False)
     assert main([str(bags / "shaky"), "--init", _init(seq), "--csv", str(tmp_path / "a.csv"),
                  "--config", str(tmp_path / "p.yaml")]) == 0
     assert main([str(bags / "shaky"), "--init", _init(seq), "--csv", str(tmp_path / "b.csv"), "--no-gyro"]) == 0
     assert (tmp_path / "a.csv").read_bytes() == (tmp_path / "b.csv").read_bytes()
-    params[node]["ros__parameters"]["imu_wait_ms"] = -1.0
-    (tmp_path / "bad.yaml").write_text(yaml.safe_dump(params))
+    node_parameter_file(tmp_path / "bad.yaml", use_gyro=False, imu_wait_ms=-1.0)
     assert main([str(bags / "shaky"), "--init", _init(seq), "--csv", str(tmp_path / "c.csv"),
                  "--config", str(tmp_path / "bad.yaml")]) == 2
 

@@ -71,10 +71,8 @@ def test_recovers_a_known_subpixel_translation_of_a_texture(dx, dy):
     assert abs(result.box[0] - (box[0] + dx)) < 0.5 and abs(result.box[1] - (box[1] + dy)) < 0.5, result.box
 
 
-def test_recovers_a_translation_of_a_real_texture(otb_root):
-    seq = load_sequence(otb_root / "Car4")
-    frame0 = read_frame(seq.frame_paths[0])
-    x, y, w, h = seq.gt_boxes[0]
+def test_recovers_a_translation_of_a_real_texture(car4_first):
+    frame0, (x, y, w, h) = car4_first
     tracker = IemdTracker(TrackerConfig(scale_step=0, update_templates=False))
     tracker.init(frame0, (x, y, w, h))
     result = tracker.update(shifted(frame0, 3.3, -2.2))
@@ -167,11 +165,10 @@ def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
     assert result.solver_warnings == len(solves) > 0
 
 
-def test_the_particles_catch_a_jump_of_half_a_window(otb_root):
+def test_the_particles_catch_a_jump_of_half_a_window(car4_first):
     """Section 6.1's particles (off by default, see TrackerConfig): Car4 moved by 0.45 window sizes, with
     no flow start, is reached from the particle 0.5 window sizes to the right and missed without them."""
-    seq = load_sequence(otb_root / "Car4")
-    frame, box = read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0])
+    frame, box = car4_first
     jump = np.array([0.45 * box[2], 0.03 * box[3]])
     moved = shifted(frame, *jump)
     config = TrackerConfig(scale_step=0, flow_start=False, particle_trigger=0.0, update_templates=False)
