@@ -104,6 +104,18 @@ def _parameter_sections(tree: dict, names: tuple = ()):
             yield from _parameter_sections(value, names + (str(key),))
 
 
+def _dotted(params: dict, prefix: str = "") -> dict:
+    """A section's ``ros__parameters`` with nested groups flattened to dotted names (``tracker: {n_iter: 7}``
+    -> ``tracker.n_iter: 7``), as rcl reads a parameter file, so that sections merge parameter by parameter."""
+    flat: dict = {}
+    for key, value in params.items():
+        if isinstance(value, dict):
+            flat.update(_dotted(value, f"{prefix}{key}."))
+        else:
+            flat[f"{prefix}{key}"] = value
+    return flat
+
+
 @dataclass
 class PipelineConfig:
     """Tracker + gyro settings and the pipeline's own.
@@ -198,17 +210,18 @@ class PipelineConfig:
         if not sections:
             return cls.from_dict(values)
         wildcard = [params for _, node, params in sections if node in _WILDCARD_NODES]
-        named = [(node, params) for _, node, params in sections if node not in _WILDCARD_NODES]
+        named = [(where, node, params) for where, node, params in sections if node not in _WILDCARD_NODES]
         if len(named) > 1:
-            named = [(node, params) for node, params in named if node == node_name]
-            if len(named) != 1:
-                raise ValueError(f"config {path} holds parameters of {len(sections)} nodes "
-                                 f"({', '.join(where for where, _, _ in sections)}) and not one named {node_name}")
+            own = [section for section in named if section[1] == node_name]
+            if len(own) != 1:
+                raise ValueError(f"config {path} holds parameters of {len(named)} nodes "
+                                 f"({', '.join(where for where, _, _ in named)}) and not one named {node_name}")
+            named = own
         merged: dict = {}
-        for params in wildcard + [params for _, params in named]:
+        for params in wildcard + [params for _, _, params in named]:
             if not isinstance(params, dict):
                 raise ValueError(f"config {path}: ros__parameters must be a mapping, got {params!r}")
-            merged.update(params)
+            merged.update(_dotted(params))
         try:
             return cls.from_parameters(merged)
         except ValueError as exc:

@@ -280,6 +280,11 @@ def test_config_from_yaml_reads_the_node_parameter_file_nested_or_dotted(tmp_pat
                                       "camera_driver:\n  ros__parameters:\n    use_gyro: 3\n")
     ns = PipelineConfig.from_yaml(tmp_path / "ns.yaml")
     assert (ns.tracker.n_iter, ns.imu_wait_ms, ns.use_gyro) == (12, 5.0, True)
+    # ... parameter by parameter: a group in the node's section adds to the wildcard's group, not replaces it
+    (tmp_path / "groups.yaml").write_text("/**:\n  ros__parameters:\n    tracker: {n_iter: 7, lam: 0.2}\n"
+                                          "iemd_tracker:\n  ros__parameters:\n    tracker: {n_iter: 9}\n")
+    groups = PipelineConfig.from_yaml(tmp_path / "groups.yaml").tracker
+    assert (groups.n_iter, groups.lam) == (9, 0.2)
     node = "iemd_tracker:\n  ros__parameters:\n"
     for text, match in [(node + "    tracker.n_iters: 10\n", "unknown tracker parameters"),
                         ("a:\n  ros__parameters: {}\nb:\n  ros__parameters: {}\n", "2 nodes .*not one named"),
