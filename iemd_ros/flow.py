@@ -61,7 +61,9 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     prev_roi, cur_roi = previous[y0:y1, x0:x1], current[y0:y1, x0:x1]
     moved, found, _ = cv2.calcOpticalFlowPyrLK(prev_roi, cur_roi, points, guess.copy(),
                                                flags=cv2.OPTFLOW_USE_INITIAL_FLOW, **_LK)
-    back, found_back, _ = cv2.calcOpticalFlowPyrLK(cur_roi, prev_roi, moved, points.copy(),
+    # The backward pass is seeded where the prior alone takes the points back, not at the points
+    # themselves: seeded at the answer, it could hardly miss it, and the check would pass anything.
+    back, found_back, _ = cv2.calcOpticalFlowPyrLK(cur_roi, prev_roi, moved, moved - (guess - points),
                                                    flags=cv2.OPTFLOW_USE_INITIAL_FLOW, **_LK)
     error = np.linalg.norm((back - points).reshape(-1, 2), axis=1)
     good = (found.ravel() == 1) & (found_back.ravel() == 1) & (error < max_error)

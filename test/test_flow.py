@@ -45,6 +45,12 @@ def test_no_start_without_texture_or_inside_the_image():
                                atol=0.2)
 
 
+def test_the_forward_backward_check_drops_content_that_does_not_reappear():
+    """Two unrelated textures: Lucas-Kanade ends somewhere for every point, but tracking back from there does
+    not return to the point (seeded at the point itself, the backward pass returned to it: a 48 px start)."""
+    assert window_flow(texture(seed=3), texture(seed=4), (40, 30, 40, 40)) is None
+
+
 def test_the_flow_start_catches_a_jump_outside_the_convergence_region(car4):
     """Car4 moved by 0.2 window sizes (22 px): without the particles only the flow start reaches it."""
     frame, box = car4
