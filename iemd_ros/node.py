@@ -4,7 +4,8 @@ Topics (relative names, remap with ``-r image:=/camera/image_raw`` ...):
 
 * subscribes ``image`` (sensor_msgs/Image: mono8, mono16, bgr8, rgb8, bgra8, rgba8; with
   ``image_transport`` "compressed": sensor_msgs/CompressedImage on ``<image>/compressed``, jpeg or
-  png as image_transport's compressed plugin publishes them), ``imu``
+  png as image_transport's compressed plugin publishes them; ``image`` remapped to a compressed stream
+  itself is taken as it is), ``imu``
   (sensor_msgs/Imu, angular velocity in the IMU frame), ``camera_info`` (sensor_msgs/CameraInfo: K,
   plumb_bob D); sensor-data QoS (best effort) unless ``reliable_qos`` is true.
 * publishes ``detections`` (vision_msgs/Detection2DArray, the image's header, one Detection2D while
@@ -45,7 +46,8 @@ from vision_msgs.msg import Detection2D, Detection2DArray, ObjectHypothesisWithP
 from .boxes import check_box
 from .cli import one_line
 from .conversions import (CLASS_ID, DETECTION_ID, bbox_to_box, bbox_values, camera_model_from_msg, detection_values,
-                          compressed_topic, fill_bbox, fill_image_msg, image_from_msg, imu_sample, stamp_ns)
+                          compressed_topic, fill_bbox, fill_image_msg, image_from_msg, imu_sample, is_compressed_topic,
+                          raw_twin, stamp_ns)
 from .drawing import draw_result
 from .gyro import GyroConfig
 from .pipeline import ERROR, NODE_NAME, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline, gyro_config_to_dict
@@ -167,12 +169,7 @@ class TrackerNode(Node):
         self._det_pub = self.create_publisher(Detection2DArray, "detections", 10)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         self._debug_pub = self.create_publisher(Image, "~/debug_image", 1)
-        # image_transport's naming: the compressed stream of the (remapped) image topic is <image>/compressed.
-        if transport == "compressed":
-            image_sub = self.create_subscription(CompressedImage, compressed_topic(self.resolve_topic_name("image")),
-                                                 self._on_image, sensor_qos)
-        else:
-            image_sub = self.create_subscription(Image, "image", self._on_image, sensor_qos)
+        image_sub = self._subscribe_image(transport, sensor_qos)
         self._image_topic = image_sub.topic_name  # after remapping
         self.create_subscription(Imu, "imu", self._on_imu, imu_qos)
         self.create_subscription(CameraInfo, "camera_info", self._on_camera_info, sensor_qos)
@@ -192,6 +189,24 @@ class TrackerNode(Node):
     def _declare(self, name, value, descriptor) -> None:
         self.declare_parameter(name, value, descriptor)
         self._declared.append(name)
+
+    def _subscribe_image(self, transport: str, qos):
+        """The image subscription.  image_transport's naming: the compressed stream of the (remapped) image
+        topic is <image>/compressed.  An image topic remapped to a compressed stream itself is taken as it
+        is with the compressed transport (not <image>/compressed/compressed), and warned about with the raw
+        one (an Image subscription there would never match the publisher's type)."""
+        image_topic = self.resolve_topic_name("image")
+        compressed_name = is_compressed_topic(image_topic)
+        if transport == "compressed":
+            if compressed_name:
+                self.get_logger().warning(f"image is remapped to {image_topic}, a compressed stream: subscribing to "
+                                          f"it (image_transport's convention is image:={raw_twin(image_topic)})")
+            topic = image_topic if compressed_name else compressed_topic(image_topic)
+            return self.create_subscription(CompressedImage, topic, self._on_image, qos)
+        if compressed_name:
+            self.get_logger().warning(f"image is remapped to {image_topic}, which looks like a compressed stream; "
+                                      f"for sensor_msgs/CompressedImage set image_transport to 'compressed'")
+        return self.create_subscription(Image, "image", self._on_image, qos)
 
     def _declare_all(self) -> None:
         self._declared: list[str] = []

@@ -264,6 +264,20 @@ def test_compressed_transport_tracks_as_raw_images_do(ctx, seq):
         assert node._worker.is_alive()
 
 
+def test_an_image_topic_remapped_to_a_compressed_stream_is_taken_as_it_is(ctx):
+    """-r image:=/cam/image_raw/compressed with the compressed transport subscribes to that stream, not to
+    /cam/image_raw/compressed/compressed where nothing is published."""
+    for image_topic, transport, expected in [("/cam/image_raw/compressed", "compressed", "/cam/image_raw/compressed"),
+                                             ("/cam/image_raw", "compressed", "/cam/image_raw/compressed"),
+                                             ("/cam/image_raw", "raw", "/cam/image_raw")]:
+        node = TrackerNode(context=ctx, cli_args=["--ros-args", "-r", f"image:={image_topic}"],
+                           parameter_overrides=[Parameter("image_transport", value=transport)])
+        try:
+            assert node._image_topic == expected, (image_topic, transport)
+        finally:
+            node.destroy_node()
+
+
 def test_unknown_image_transport_is_refused(ctx):
     with pytest.raises(ValueError, match="image_transport must be 'raw' or 'compressed', got 'theora'"):
         TrackerNode(context=ctx, parameter_overrides=[Parameter("image_transport", value="theora")])
