@@ -67,8 +67,7 @@ def main() -> int:
     if not a.desk.is_dir():
         print(f"replay_speed: the desk recording is not at {a.desk}", file=sys.stderr)
         return 2
-    tmp = Path(tempfile.mkdtemp(prefix="iemd_replay_speed_"))     # holds the bags unless --keep
-    folder = a.keep if a.keep is not None else tmp
+    folder = a.keep if a.keep is not None else Path(tempfile.mkdtemp(prefix="iemd_replay_speed_"))
     try:
         src = source_from_folder(a.desk)
         bags = {}
@@ -113,7 +112,8 @@ def main() -> int:
               f"update must stay below {max(1e3 * (dur / 3 - rest - res.init_s) / n, 0):.1f} ms/frame")
         return 0
     finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        if a.keep is None:
+            shutil.rmtree(folder, ignore_errors=True)
 
 
 if __name__ == "__main__":
