@@ -8,9 +8,10 @@ to (after a frame reported lost, the tracker keeps its previous window, so the r
 integrated from that frame).  Scores (iemd_ros.metrics) over the first 100 frames (the paper's
 sequence length) and over the whole sequence, from the init frame on (the init frame included, as
 in OTB); frames whose GT is absent are excluded (the desk GT has none).  Both modes use the
-paper's ±10 % scale search of its gyro experiment (``--scale-range``, TrackerConfig.scale_range).
+tracker's scale estimator (``--scale-estimator``); with the paper's EMD scale variants, the ±10 %
+scale search of its gyro experiment (``--scale-range``, TrackerConfig.scale_range).
 
-    PYTHONPATH=. .venv/bin/python benchmarks/gyro_desk.py [--frames N] [--imu-root ../shared/data/imu]
+    PYTHONPATH=. .venv/bin/python benchmarks/gyro_desk.py [--frames N] [--scale-estimator emd]
 """
 from __future__ import annotations
 
@@ -28,9 +29,9 @@ from iemd_ros.recordings import load_recording, track_recording
 DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu"
 
 
-def run(rec, start: int, stop: int, use_gyro: bool, scale_range: float):
+def run(rec, start: int, stop: int, use_gyro: bool, config: TrackerConfig):
     """Tracker boxes for frames start..stop-1 (the init frame gets its GT box), lost count, prior notes."""
-    results, no_prior = track_recording(rec, start, stop, use_gyro, TrackerConfig(scale_range=scale_range))
+    results, no_prior = track_recording(rec, start, stop, use_gyro, config)
     boxes = [np.asarray(rec.gt_boxes[start], float)] + [np.asarray(r.box, float) for r in results]
     return np.array(boxes), sum(r.lost for r in results), no_prior
 
@@ -40,7 +41,10 @@ def main(argv=None) -> int:
     ap.add_argument("--imu-root", type=Path, default=DEFAULT_ROOT)
     ap.add_argument("--frames", type=int, default=0, help="track only this many frames (0: whole sequence)")
     ap.add_argument("--scale-range", type=float, default=0.1,
-                    help="largest scale change per frame searched (paper's gyro experiment: 0.1)")
+                    help="with --scale-estimator emd: largest scale change per frame searched (paper's gyro "
+                         "experiment: 0.1)")
+    ap.add_argument("--scale-estimator", choices=("filter", "emd"), default=TrackerConfig.scale_estimator,
+                    help="TrackerConfig.scale_estimator (default: %(default)s)")
     ap.add_argument("--save", type=Path, help="write the boxes of both runs and the GT to this .npz file")
     args = ap.parse_args(argv)
     folder = args.imu_root / "cmu_hwangbo_desk"
@@ -58,10 +62,11 @@ def main(argv=None) -> int:
     ok = np.nonzero(rec.gt_flags == "ok")[0]
     start = int(ok[0])
     stop = len(rec) if args.frames == 0 else min(len(rec), start + args.frames)
+    config = TrackerConfig(scale_estimator=args.scale_estimator, scale_range=args.scale_range)
     results = {}
     for use_gyro in (True, False):
         t0 = time.perf_counter()
-        boxes, n_lost, no_prior = run(rec, start, stop, use_gyro, args.scale_range)
+        boxes, n_lost, no_prior = run(rec, start, stop, use_gyro, config)
         dt = time.perf_counter() - t0
         results[use_gyro] = boxes
         label = "gyro-aided" if use_gyro else "no gyro"

@@ -10,8 +10,8 @@
   peer the same share for the normalized cross-correlation (NCC) of the frame-1 window.
 * in the loop: the tracker run with an oracle translation (its centre set to the ground-truth
   centre before each update; no descent, flow start or coarse stage), so only its scale moves:
-  the mean |log| of its size against the ground truth's (sqrt of the areas), with the paper's EMD
-  scale variants and with no scale search at all.
+  the mean |log| of its size against the ground truth's (sqrt of the areas), with the scale filter
+  (the default), the paper's EMD scale variants, and no scale search at all.
 """
 from __future__ import annotations
 
@@ -73,7 +73,7 @@ def main():
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     names = sequence_names(args.sequences)
-    configs = {"EMD variants": {}, "no scale search": {"scale_step": 0.0}}
+    configs = {"scale filter": {}, "EMD variants": {"scale_estimator": "emd"}, "no scale search": {"scale_step": 0.0}}
     with Pool(args.jobs) as pool:
         curves = pool.map(curve, [(name, args.stride) for name in names])
         loop = {label: pool.map(oracle_translation, [(name, config) for name in names])

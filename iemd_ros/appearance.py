@@ -75,6 +75,29 @@ class ImagePyramid:
         padded by replicating the border.
         """
         tw, th = template_size
+        level, linear, centre = self._geometry(center, size, template_size, coarse, angle)
+        warp = np.column_stack([linear, centre - linear @ [(tw - 1) / 2, (th - 1) / 2]])
+        return cv2.warpAffine(
+            self.level(level), warp, (int(tw), int(th)),
+            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE,
+        )
+
+    def sample_scales(self, center, size, template_size, factors, angle: float = 0.0) -> np.ndarray:
+        """The window scaled by each of ``factors`` about its centre, resampled to (Th, Tw) templates:
+        (len(factors), Th, Tw), in one remap from the anti-aliasing level of the unscaled window (the same
+        smoothing at every scale, so the templates differ by their scale only)."""
+        tw, th = template_size
+        level, linear, centre = self._geometry(center, size, template_size, 0, angle)
+        grid = np.stack(np.meshgrid(np.arange(tw) - (tw - 1) / 2, np.arange(th) - (th - 1) / 2))  # (2, Th, Tw)
+        offsets = np.einsum("ij,jhw->ihw", linear, grid)  # image offset of each template pixel at scale 1
+        maps = centre[:, None, None, None] + np.asarray(factors, dtype=np.float64)[None, :, None, None] * offsets[:, None]
+        maps = maps.reshape(2, -1, int(tw)).astype(np.float32)
+        out = cv2.remap(self.level(level), maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        return out.reshape(len(factors), int(th), int(tw))
+
+    def _geometry(self, center, size, template_size, coarse: int, angle: float):
+        """(pyramid level, linear map of template pixels to that level's pixels, window centre there)."""
+        tw, th = template_size
         sx, sy = size[0] / tw, size[1] / th
         level = int(np.floor(np.log2(max(min(sx, sy), 1.0)))) + coarse
         level = min(max(level, 0), self.n_levels - 1)
@@ -82,12 +105,7 @@ class ImagePyramid:
         # Image point of template pixel u: c + R(angle) ((u - (T-1)/2) * s); at level l
         # a full-resolution coordinate x sits at (x + 0.5) / 2^l - 0.5.
         linear = window_axes(angle) * [sx, sy] / f
-        origin = (np.asarray(center, dtype=np.float64) + 0.5) / f - 0.5 - linear @ [(tw - 1) / 2, (th - 1) / 2]
-        warp = np.column_stack([linear, origin])
-        return cv2.warpAffine(
-            self.level(level), warp, (int(tw), int(th)),
-            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE,
-        )
+        return level, linear, (np.asarray(center, dtype=np.float64) + 0.5) / f - 0.5
 
 
 @dataclass(frozen=True)

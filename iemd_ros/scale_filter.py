@@ -1,0 +1,169 @@
+"""Discriminative scale estimation: a one-dimensional correlation filter over scales (DSST).
+
+Why the tracker needs it: the EMD of the iEMD histograms hardly changes with the window's scale.
+Its patch positions are in normalized window units and its patches are normalized, so a window
+13 % too large or too small scores almost the same EMD.  Measured at the ground-truth centre with
+the frame-1 target model, every 5th frame, median EMD(s) / EMD(1) for s = 0.87 / 1.15
+(``benchmarks/scale_curve.py``): Car4 1.15 / 1.11, but Woman 1.02 / 1.01, David 1.01 / 1.05, Bolt2
+1.00 / 1.01; the paper's +-2 % variants then choose a scale by noise.  Keeping the window at the
+ground-truth size (an oracle scale) lifted the tracker's Car4 / Woman average overlap from
+36.7 / 51.6 % to 90.7 / 75.8 %.
+
+The filter is Danelljan et al.'s scale filter ("Accurate Scale Estimation for Robust Visual
+Tracking", BMVC 2014): the window at ``n_scales`` scales ``scale_step**k`` around the current
+size is resampled to one small model size and described by gradient-orientation histograms; the
+features of the scales, tapered by a Hann window over the scale axis, form a d x S sample whose
+desired response is a Gaussian peaked at the current scale.  The filter (eq. 5 of DSST, solved in
+the Fourier domain along the scale axis) and its running average (learning rate eta) give, on the
+next frame, the scale whose response peaks.  It learns what the target looks like at its own scale
+against itself a little larger and smaller, which is what the generative EMD cannot see.
+
+Choices, measured over the 12 OTB sequences x 5 starts (mean average overlap; the EMD variants 32.5 %):
+DSST's 33 scales 1.02 apart, learning rate 0.025, regularization 0.01 and 512-pixel model; all scales
+sampled from one pyramid level, so their smoothing differs by the scale only (34.4 %; each from its own
+anti-aliasing level 35.7 %, at 6x the sampling cost); learning from the estimate's own sample (DSST
+samples the new window again: 35.0 %, 1.2 ms more per frame).  In an earlier setting of the flow
+start, 17 scales scored 33.2 % where 33 sampled twice scored 35.6 %.
+"""
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from .appearance import ImagePyramid
+
+N_ORIENTATIONS = 9  # unsigned gradient orientation bins of the features
+CELL = 4  # feature cell size, model pixels
+FLOOR = 0.05  # added to a cell histogram's norm (gradient magnitudes in grey levels per pixel, [0, 1] scale)
+
+
+class ScaleFilter:
+    """DSST scale filter: ``init`` at the target's window, then per frame ``estimate`` and, when the
+    frame is tracked, ``update``.
+
+    Windows are (centre, size (w, h), angle) as in :meth:`ImagePyramid.sample`.  ``update`` learns from
+    the sample ``estimate`` took, its desired response centred on the estimated scale (a shift along
+    the scale axis, a phase in the Fourier domain) rather than from a second sample at the new size as
+    DSST does: one sample per frame instead of two.
+    """
+
+    def __init__(self, n_scales: int = 33, scale_step: float = 1.02, learning_rate: float = 0.025,
+                 regularization: float = 0.01, sigma: float = 1.4375, model_area: int = 512):
+        if n_scales < 3 or n_scales % 2 == 0:
+            raise ValueError(f"n_scales must be odd and >= 3, got {n_scales}")
+        if not scale_step > 1.0:
+            raise ValueError(f"scale_step must be > 1, got {scale_step}")
+        if not 0.0 < learning_rate <= 1.0:
+            raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
+        offsets = np.arange(n_scales) - n_scales // 2
+        self.step = scale_step
+        self.factors = scale_step ** offsets  # relative scales, ascending; the middle one is 1
+        # Desired response: a Gaussian over the scale index (sigma in scale steps: DSST's 33 / sqrt(33) / 4)
+        # peaked at the middle, and the frequencies that shift it.
+        self._desired = np.fft.fft(np.exp(-0.5 * (offsets / sigma) ** 2))
+        self._frequencies = 2.0 * np.pi * np.fft.fftfreq(n_scales)
+        self._taper = np.hanning(n_scales + 2)[1:-1]  # Hann window over the scales (no zero ends)
+        self.learning_rate = learning_rate
+        self.regularization = regularization
+        self.model_area = model_area
+        self.model_size = None  # (w, h) of the resampled windows, multiples of CELL
+        self._numerator = None  # G conj(F), (d, S)
+        self._denominator = None  # sum_l |F_l|^2, (S,)
+        self._last = None  # (spectrum, estimated shift in scale steps) of the last estimate
+
+    def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
+        """Learn the filter from the window (``center``, ``size``) of the first frame."""
+        w, h = (float(v) for v in size)
+        f = np.sqrt(self.model_area / (w * h))
+        self.model_size = tuple(int(max(2, round(v * f / CELL))) * CELL for v in (w, h))
+        self._numerator, self._denominator = self._learn(self._spectrum(pyramid, center, size, angle), 0.0)
+        self._last = None
+
+    def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> float:
+        """Relative scale of the target in ``pyramid``'s frame against the window ``size`` at ``center``: the
+        factor where the filter response peaks, refined between scales by a parabola through the peak."""
+        if self._numerator is None:
+            raise RuntimeError("ScaleFilter.estimate() called before init()")
+        spectrum = self._spectrum(pyramid, center, size, angle)
+        response = np.fft.ifft((self._numerator * spectrum).sum(0) / (self._denominator + self.regularization)).real
+        peak = int(np.argmax(response))
+        shift = peak - len(response) // 2
+        if 0 < peak < len(response) - 1:
+            left, centre, right = response[peak - 1:peak + 2]
+            curvature = left - 2.0 * centre + right
+            if curvature < 0:
+                shift += 0.5 * (left - right) / curvature
+        self._last = (spectrum, shift)
+        return float(self.step**shift)
+
+    def update(self) -> None:
+        """Blend the last estimate's sample in (the running average of DSST eq. 5), its desired response
+        peaked at the scale it estimated."""
+        if self._last is None:
+            raise RuntimeError("ScaleFilter.update() needs an estimate() first")
+        numerator, denominator = self._learn(*self._last)
+        eta = self.learning_rate
+        self._numerator = (1.0 - eta) * self._numerator + eta * numerator
+        self._denominator = (1.0 - eta) * self._denominator + eta * denominator
+        self._last = None
+
+    # ------------------------------------------------------------ internals
+    def _learn(self, spectrum: np.ndarray, shift: float):
+        desired = self._desired * np.exp(-1j * self._frequencies * shift)
+        return desired * np.conj(spectrum), (spectrum * np.conj(spectrum)).real.sum(0)
+
+    def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
+        """FFT along the scales of the (d, S) sample: per scale, the window at that scale resampled to the
+        model size and described by :func:`orientation_histograms`, tapered by the Hann window over the scales."""
+        size = np.asarray(size, dtype=np.float64)
+        windows = pyramid.sample_scales(center, size, self.model_size, self.factors, angle)
+        return np.fft.fft(orientation_histograms(windows).T * self._taper, axis=1)
+
+
+def orientation_histograms(windows: np.ndarray) -> np.ndarray:
+    """Per window of ``windows`` (S, H, W), its gradient-orientation histograms as one vector (S, d).
+
+    Central-difference gradients (one-sided at the border); unsigned orientations in ``N_ORIENTATIONS``
+    bins, weighted by the gradient magnitude, summed over CELL x CELL cells; each cell's histogram divided
+    by its L2 norm plus a floor (flat cells stay short): a HOG without blocks, invariant to brightness
+    and contrast.  H and W are multiples of CELL.
+    """
+    windows = np.ascontiguousarray(windows, dtype=np.float32)
+    n, h, w = windows.shape
+    if h % CELL or w % CELL:
+        raise ValueError(f"window size {w}x{h} is not a multiple of the {CELL} px cell")
+    return _orientation_histograms(windows).reshape(n, -1)
+
+
+_BOUNDARY_COS = np.cos(np.arange(N_ORIENTATIONS) * np.pi / N_ORIENTATIONS)
+_BOUNDARY_SIN = np.sin(np.arange(N_ORIENTATIONS) * np.pi / N_ORIENTATIONS)
+
+
+@numba.njit(cache=True)
+def _orientation_histograms(windows):
+    n, h, w = windows.shape
+    n_rows, n_cols = h // CELL, w // CELL
+    hist = np.zeros((n, n_rows, n_cols, N_ORIENTATIONS))
+    for k in range(n):
+        for y in range(h):
+            y0, y1 = max(y - 1, 0), min(y + 1, h - 1)
+            for x in range(w):
+                x0, x1 = max(x - 1, 0), min(x + 1, w - 1)
+                gx = (windows[k, y, x1] - windows[k, y, x0]) / (x1 - x0)
+                gy = (windows[k, y1, x] - windows[k, y0, x]) / (y1 - y0)
+                if gy < 0.0 or (gy == 0.0 and gx < 0.0):  # unsigned: fold onto [0, pi)
+                    gx, gy = -gx, -gy
+                b = 0  # the last bin boundary at or below the orientation
+                while b < N_ORIENTATIONS - 1 and gy * _BOUNDARY_COS[b + 1] >= gx * _BOUNDARY_SIN[b + 1]:
+                    b += 1
+                hist[k, y // CELL, x // CELL, b] += np.sqrt(gx * gx + gy * gy)
+    for k in range(n):
+        for r in range(n_rows):
+            for c in range(n_cols):
+                norm = 0.0
+                for b in range(N_ORIENTATIONS):
+                    norm += hist[k, r, c, b] ** 2
+                scale = 1.0 / (np.sqrt(norm) + FLOOR)
+                for b in range(N_ORIENTATIONS):
+                    hist[k, r, c, b] *= scale
+    return hist

@@ -1,0 +1,103 @@
+"""The DSST scale filter (iemd_ros/scale_filter.py) and the tracker's use of it."""
+import cv2
+import numpy as np
+import pytest
+
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.appearance import ImagePyramid, to_gray
+from iemd_ros.boxes import box_centre
+from iemd_ros.scale_filter import FLOOR, ScaleFilter, orientation_histograms
+
+
+def zoomed(frame, centre, factor):
+    """``frame`` magnified by ``factor`` about ``centre`` (the target grows by ``factor``)."""
+    cx, cy = centre
+    warp = np.array([[factor, 0.0, cx * (1 - factor)], [0.0, factor, cy * (1 - factor)]])
+    return cv2.warpAffine(frame, warp, (frame.shape[1], frame.shape[0]), flags=cv2.INTER_LINEAR,
+                          borderMode=cv2.BORDER_REPLICATE)
+
+
+def test_orientation_histograms_of_edges_by_hand():
+    """A vertical step edge 0 -> 1 between columns 3 and 4 of a 4x8 window: central differences give
+    0.5 at columns 3 and 4 (horizontal gradient, orientation 0: bin 0), so each 4x4 cell holds 4 x 0.5 = 2
+    in bin 0, divided by 2 + FLOOR.  The reversed edge falls in the same (unsigned) bin; a horizontal edge
+    (orientation 90 degrees) in bin 4 (20-degree bins); a diagonal ramp (45 degrees) in bin 2."""
+    step = np.zeros((4, 8), np.float32)
+    step[:, 4:] = 1.0
+    expected = np.zeros((2, 9))
+    expected[:, 0] = 2.0 / (2.0 + FLOOR)
+    out = orientation_histograms(np.stack([step, 1.0 - step]))
+    np.testing.assert_allclose(out, np.stack([expected.ravel()] * 2), rtol=1e-6)
+
+    horizontal = np.zeros((8, 4), np.float32)
+    horizontal[4:] = 1.0
+    assert np.flatnonzero(orientation_histograms(horizontal[None]).reshape(2, 9).sum(0)).tolist() == [4]
+    ramp = np.add.outer(np.arange(8.0), np.arange(8.0)).astype(np.float32)[None] / 16.0
+    assert np.flatnonzero(orientation_histograms(ramp).reshape(4, 9).sum(0)).tolist() == [2]
+    assert not orientation_histograms(np.full((1, 8, 8), 0.5, np.float32)).any()  # flat: no gradient, zeros
+    with pytest.raises(ValueError, match="multiple of the 4 px cell"):
+        orientation_histograms(np.zeros((1, 6, 8), np.float32))
+
+
+def test_the_scaled_windows_are_the_windows_sampled_one_by_one(car4_first):
+    frame, box = car4_first
+    pyramid = ImagePyramid(to_gray(frame))
+    factors = 1.02 ** np.arange(-2, 3)  # these share the unscaled window's anti-aliasing level
+    for angle in (0.0, 0.6):
+        stacked = pyramid.sample_scales(box_centre(box), box[2:], (24, 20), factors, angle)
+        one_by_one = [pyramid.sample(box_centre(box), box[2:] * f, (24, 20), 0, angle) for f in factors]
+        np.testing.assert_allclose(stacked, np.stack(one_by_one), atol=1e-4)
+
+
+def test_recovers_a_known_scale_change_of_a_real_window(car4_first):
+    """Learned on Car4's target, the filter measures the target against windows 10 % too small or too
+    large (1/0.9 = 1.111 and 1/1.1 = 0.909), and against a frame magnified by 6 %."""
+    frame, box = car4_first
+    pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(box), box[2:]
+    scale_filter = ScaleFilter()
+    scale_filter.init(pyramid, centre, size)
+    assert scale_filter.estimate(pyramid, centre, size) == pytest.approx(1.0, abs=1e-9)
+    for window in (0.9, 1.1):
+        assert scale_filter.estimate(pyramid, centre, size * window) == pytest.approx(1.0 / window, rel=0.025)
+    bigger = ImagePyramid(to_gray(zoomed(frame, centre, 1.06)))
+    assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.06, rel=0.015)
+
+
+def test_update_learns_at_the_estimated_scale(car4_first):
+    """update() learns the last estimate's sample with its desired response centred on the estimated
+    scale: after learning the 6 % larger target, that target is measured at scale 1 from its own size."""
+    frame, box = car4_first
+    pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(box), box[2:]
+    scale_filter = ScaleFilter(learning_rate=1.0)  # the new sample replaces the filter
+    scale_filter.init(pyramid, centre, size)
+    bigger = ImagePyramid(to_gray(zoomed(frame, centre, 1.06)))
+    scale = scale_filter.estimate(bigger, centre, size)
+    scale_filter.update()
+    assert scale_filter.estimate(bigger, centre, size * scale) == pytest.approx(1.0, abs=0.01)
+    scale_filter.update()
+    with pytest.raises(RuntimeError, match="needs an estimate"):  # each estimate is learned at most once
+        scale_filter.update()
+
+
+def test_invalid_use_is_refused():
+    with pytest.raises(RuntimeError, match="before init"):
+        ScaleFilter().estimate(ImagePyramid(np.zeros((64, 64), np.float32)), (32, 32), (16, 16))
+    for kwargs, message in [({"n_scales": 4}, "odd"), ({"scale_step": 1.0}, "> 1"), ({"learning_rate": 0}, "learning_rate must be")]:
+        with pytest.raises(ValueError, match=message):
+            ScaleFilter(**kwargs)
+    with pytest.raises(ValueError, match="scale_estimator must be 'emd' or 'filter'"):
+        TrackerConfig(scale_estimator="dsst")
+
+
+def test_the_tracker_follows_a_zoom_the_emd_variants_cannot(car4_first):
+    """Car4's frame magnified by 8 % about the target: the filter takes the window to 1.08 in one frame; the
+    paper's EMD variants move at most scale_range (2 %) per frame, and scale_step 0 keeps the size."""
+    frame, box = car4_first
+    scales = {}
+    for estimator, step in [("filter", 0.02), ("emd", 0.02), ("filter", 0.0)]:
+        tracker = IemdTracker(TrackerConfig(scale_estimator=estimator, scale_step=step, update_templates=False))
+        tracker.init(frame, box)
+        scales[estimator, step] = tracker.update(zoomed(frame, box_centre(box), 1.08)).scale
+    assert scales["filter", 0.02] == pytest.approx(1.08, rel=0.02)
+    assert 1.0 <= scales["emd", 0.02] <= 1.02 + 1e-12
+    assert scales["filter", 0.0] == 1.0
