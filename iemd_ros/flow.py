@@ -26,7 +26,7 @@ _LK = dict(winSize=(11, 11), maxLevel=3)
 
 
 def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarray | None = None,
-                max_error: float = 1.0) -> np.ndarray | None:
+                max_error: float = 2.0) -> np.ndarray | None:
     """Median motion (dx, dy) in px of the content of ``box`` from ``previous`` into ``current``
     beyond what ``prior`` predicts, or None when too few points can be followed.
 
