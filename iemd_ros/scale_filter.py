@@ -19,7 +19,8 @@ next frame, the scale whose response peaks.  It learns what the target looks lik
 against itself a little larger and smaller, which is what the generative EMD cannot see.
 
 Choices, measured over the 12 OTB sequences x 5 starts (mean average overlap; the EMD variants 32.5 %):
-DSST's 33 scales 1.02 apart, learning rate 0.025, regularization 0.01 and 512-pixel model; all scales
+DSST's 33 scales 1.02 apart, learning rate 0.025 (0.01 / 0.05 scored 31.8 / 33.1 % where 0.025 scored
+35.8 %, flow_max_error 2 px), regularization 0.01 and 512-pixel model; all scales
 sampled from one pyramid level, so their smoothing differs by the scale only (34.4 %; each from its own
 anti-aliasing level 35.7 %, at 6x the sampling cost); learning from the estimate's own sample (DSST
 samples the new window again: 35.0 %, 1.2 ms more per frame).  In an earlier setting of the flow
