@@ -90,7 +90,8 @@ class ImagePyramid:
         level, linear, centre = self._geometry(center, size, template_size, 0, angle)
         grid = np.stack(np.meshgrid(np.arange(tw) - (tw - 1) / 2, np.arange(th) - (th - 1) / 2))  # (2, Th, Tw)
         offsets = np.einsum("ij,jhw->ihw", linear, grid)  # image offset of each template pixel at scale 1
-        maps = centre[:, None, None, None] + np.asarray(factors, dtype=np.float64)[None, :, None, None] * offsets[:, None]
+        factors = np.asarray(factors, dtype=np.float64)
+        maps = centre[:, None, None, None] + factors[None, :, None, None] * offsets[:, None]
         maps = maps.reshape(2, -1, int(tw)).astype(np.float32)
         out = cv2.remap(self.level(level), maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
         return out.reshape(len(factors), int(th), int(tw))

@@ -58,8 +58,8 @@ class TrackerConfig:
     # resolution only.  Measured over the 12 OTB sequences from the ground truth and from it shifted by 10 % along
     # the 4 diagonals (60 runs), with the defaults of the time (particles off, EMD scale variants, the backward
     # Lucas-Kanade pass seeded at the points): mean average overlap 34.1 % against 20.8 % without it.  The
-    # figures that follow were measured with the particles on: 26.1 % against 22.2 % without (per start 30.5/27.0/24.0/23.7/25.5 vs 31.9/19.2/23.5/13.5/22.9 %).  Through the coarse stage too it
-    # scored 28.7 % (28.0 % with a 15x15 Lucas-Kanade window, 25.7 % at flow_max_error 2 px) but took the pooled
+    # figures that follow were measured with the particles on: 26.1 % against 22.2 % without (per start
+    # 30.5/27.0/24.0/23.7/25.5 vs 31.9/19.2/23.5/13.5/22.9 %).  Through the coarse stage too it scored 28.7 % (28.0 % with a 15x15 Lucas-Kanade window, 25.7 % at flow_max_error 2 px) but took the pooled
     # median update of benchmarks/bench_speed.py from 8.3 to 10.2 ms.  As the only start (none at the
     # prediction) a prototype scored 27.0 % vs 35.4 % from the ground truth: the flow follows occluders too,
     # the EMD has to choose.  (Particles off: the flow start alone 30.2 %, through the coarse stage 31.4 %.)
