@@ -138,8 +138,9 @@ class PatchLayout:
         return (tw - pw) // self.step + 1, (th - ph) // self.step + 1
 
     def positions(self) -> np.ndarray:
-        """(N, 2) normalized centres of the window's patches, row-major like :meth:`extract`."""
-        return self._positions.copy()
+        """(N, 2) normalized centres of the window's patches, row-major like :meth:`extract` (read-only: one
+        array shared by every model of the layout)."""
+        return self._positions
 
     @cached_property
     def _positions(self) -> np.ndarray:
@@ -149,7 +150,9 @@ class PatchLayout:
         gi, gj = np.meshgrid(np.arange(nx), np.arange(ny))
         x = (gi * self.step + (pw - 1) / 2 - (tw - 1) / 2) / (tw / 2)
         y = (gj * self.step + (ph - 1) / 2 - (th - 1) / 2) / (th / 2)
-        return np.column_stack([x.ravel(), y.ravel()]).astype(np.float64)
+        positions = np.column_stack([x.ravel(), y.ravel()]).astype(np.float64)
+        positions.flags.writeable = False
+        return positions
 
     def extract(self, template: np.ndarray) -> np.ndarray:
         """(N, m*n) appearance vectors epsilon ("normalized pixel values").
