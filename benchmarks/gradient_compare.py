@@ -42,7 +42,7 @@ def main():
             offsets = rng.uniform(-args.offset, args.offset, (args.starts, 2))
             tracker = IemdTracker()
             tracker.init(prev, seq.gt_boxes[k - 1])
-            context = tracker._context(pyramid)
+            context = tracker.search_context(pyramid)
             for offset in offsets:
                 start = CandidateModel(context, truth + offset, size)  # one start model for all three
                 for gradient in GRADIENTS:

@@ -65,7 +65,7 @@ def measure(job):
         truth = np.asarray(seq.gt_boxes[k], dtype=float)
         frame = read_frame(seq.frame_paths[k])
         pyramid = ImagePyramid(to_gray(frame))
-        context, size = tracker._context(pyramid), truth[2:]
+        context, size = tracker.search_context(pyramid), truth[2:]
 
         def emd(centre):
             return CandidateModel(context, centre, size).emd()[0]

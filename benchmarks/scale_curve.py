@@ -43,7 +43,7 @@ def curve(job):
     for k in range(stride, len(seq), stride):
         truth = np.asarray(seq.gt_boxes[k], dtype=float)
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
-        context, centre = tracker._context(pyramid), box_centre(truth)
+        context, centre = tracker.search_context(pyramid), box_centre(truth)
         emd = [CandidateModel(context, centre, truth[2:] * s).emd()[0] for s in SCALES]
         ncc = [-np.corrcoef(reference, pyramid.sample(centre, truth[2:] * s, template_size).ravel())[0, 1]
                for s in SCALES]

@@ -45,7 +45,7 @@ def discrimination(job, radius=40, grid=4):
     scores = []
     for k in picks:
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
-        context, center, size = tracker._context(pyramid), box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
+        context, center, size = tracker.search_context(pyramid), box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
         at_gt = CandidateModel(context, center, size).emd()[0]
         others = [CandidateModel(context, center + (dx, dy), size).emd()[0]
                   for dy in range(-radius, radius + 1, grid) for dx in range(-radius, radius + 1, grid)

@@ -97,7 +97,7 @@ def measure(job):
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
         center, size = box_centre(seq.gt_boxes[k]), np.asarray(seq.gt_boxes[0][2:], dtype=float)  # frame-1 size
         accuracy = votes.vote_accuracy(pyramid.sample(center, size, tsize))
-        context = tracker._context(pyramid)
+        context = tracker.search_context(pyramid)
         patch_bins = np.hypot(*grid_argmin(lambda c: CandidateModel(context, c, size).emd()[0], center, size, OFFSETS))
         vote_bins = np.hypot(*grid_argmin(lambda c: votes.emd(pyramid.sample(c, size, tsize)), center, size, OFFSETS))
         rows.append((accuracy, patch_bins, vote_bins))

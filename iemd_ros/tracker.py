@@ -282,6 +282,20 @@ class IemdTracker:
             predicted_box=predicted, reason=reason,
         )
 
+    def search_context(self, pyramid: ImagePyramid, angle: float = 0.0, coarse: bool = False) -> SearchContext:
+        """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the current target model
+        and dictionary, or (``coarse``) the coarse stage's: one pyramid level up, its own target, no sparse
+        coding.  Also for analysis: ``CandidateModel(tracker.search_context(pyramid), centre, size).emd()``
+        scores any window against the target (benchmarks/model_ceiling.py, scale_curve.py)."""
+        if self._center is None:
+            raise RuntimeError("IemdTracker.search_context() called before init()")
+        cfg = self.config
+        if coarse:
+            return SearchContext(pyramid, self.layout, self._coarse_target, None, cfg.alpha, cfg.kernel_bandwidth,
+                                 coarse=_COARSE_LEVELS, angle=angle)
+        return SearchContext(pyramid, self.layout, self._target, self.dictionary, cfg.alpha, cfg.kernel_bandwidth,
+                             angle=angle)
+
     # ------------------------------------------------------------ internals
     def _take_frame(self, frame: np.ndarray):
         """(grey levels kept from the previous frame, ``frame``'s grey levels, its pyramid).  With the flow
@@ -301,7 +315,7 @@ class IemdTracker:
         were easy, after which every frame counted as lost and, lost frames not
         updating it, it never recovered: 804 of 825 CMU desk frames.)
         """
-        context = self._context(pyramid)
+        context = self.search_context(pyramid)
         values = [CandidateModel(context, self._center + offset * self._size, self._size).emd()[0]
                   for offset in _particle_offsets(4, 1.0)]
         finite = [v for v in values if np.isfinite(v)]
@@ -320,16 +334,6 @@ class IemdTracker:
         pooled = self.dictionary.code_weights(self._target_eps)
         self._target = TargetModel.from_patches(self.layout.positions(), self._target_eps, pooled,
                                                 self.config.kernel_bandwidth)
-
-    def _context(self, pyramid: ImagePyramid, angle: float = 0.0, coarse: bool = False) -> SearchContext:
-        """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the full target and
-        dictionary, or (``coarse``) the coarse stage's: one pyramid level up, its own target, no sparse coding."""
-        cfg = self.config
-        if coarse:
-            return SearchContext(pyramid, self.layout, self._coarse_target, None, cfg.alpha, cfg.kernel_bandwidth,
-                                 coarse=_COARSE_LEVELS, angle=angle)
-        return SearchContext(pyramid, self.layout, self._target, self.dictionary, cfg.alpha, cfg.kernel_bandwidth,
-                             angle=angle)
 
     def _search(self, pyramid: ImagePyramid, starts: np.ndarray, size, angle: float, fine_starts=()) -> _Descent:
         """Coarse-to-fine Algorithm 1 from one or more starts (N, 2); only the best-scored start is refined.
@@ -358,8 +362,8 @@ class IemdTracker:
         gain (12-sequence average overlap 31.3 vs 31.9 %: a wider basin also
         reaches distractors) and updates took 3x longer, so it was not kept.
         """
-        fine = self._context(pyramid, angle)
-        coarse = self._context(pyramid, angle, coarse=True) if self.config.coarse_to_fine else None
+        fine = self.search_context(pyramid, angle)
+        coarse = self.search_context(pyramid, angle, coarse=True) if self.config.coarse_to_fine else None
         ends, warnings = [], 0
         for start in starts:
             if coarse is not None:

@@ -23,7 +23,7 @@ def model_setup():
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
     center = box_centre(box)
-    model = CandidateModel(tracker._context(ImagePyramid(to_gray(frame1))), center, np.array(box[2:], float))
+    model = CandidateModel(tracker.search_context(ImagePyramid(to_gray(frame1))), center, np.array(box[2:], float))
     return tracker, model
 
 
@@ -107,7 +107,7 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     tracker = IemdTracker(TrackerConfig(gradient="appearance"))
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
-    context = tracker._context(ImagePyramid(to_gray(frame1)))
+    context = tracker.search_context(ImagePyramid(to_gray(frame1)))
     center = box_centre(box)
     size = np.array(box[2:], float)
 

@@ -45,6 +45,8 @@ def test_invalid_prior_and_call_order():
     tracker = IemdTracker()
     with pytest.raises(RuntimeError, match="before init"):
         tracker.update(frame)
+    with pytest.raises(RuntimeError, match="search_context.. called before init"):
+        tracker.search_context(ImagePyramid(to_gray(frame)))
     tracker.init(frame, (100, 80, 40, 40))
     for prior, match in [(np.eye(2), "3x3"), (np.full((3, 3), np.nan), "non-finite"), (np.zeros((3, 3)), "singular")]:
         with pytest.raises(ValueError, match=match):
