@@ -36,10 +36,26 @@ def texture(seed=0, shape=(240, 320), blob=5):
     return np.clip(cv2.resize(noise, (shape[1], shape[0]), interpolation=cv2.INTER_CUBIC), 0, 255).astype(np.uint8)
 
 
+def warped(img, m, interpolation=cv2.INTER_CUBIC, border=cv2.BORDER_REFLECT):
+    """``img`` moved by the 2x3 affine map ``m`` (image to image pixels), same size."""
+    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=interpolation, borderMode=border)
+
+
 def shifted(img, dx, dy, interpolation=cv2.INTER_CUBIC):
     """``img`` translated by (dx, dy) px, borders reflected."""
-    m = np.float32([[1, 0, dx], [0, 1, dy]])
-    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=interpolation, borderMode=cv2.BORDER_REFLECT)
+    return warped(img, np.float32([[1, 0, dx], [0, 1, dy]]), interpolation)
+
+
+def rotated(img, center, degrees):
+    """``img`` turned by ``degrees`` about ``center`` (positive: from +x towards +y in the image), borders reflected."""
+    return warped(img, cv2.getRotationMatrix2D((float(center[0]), float(center[1])), -degrees, 1.0))
+
+
+def zoomed(img, center, factor):
+    """``img`` magnified by ``factor`` about ``center`` (a target there grows by ``factor``), borders replicated."""
+    (cx, cy), f = center, factor
+    m = np.array([[f, 0.0, cx * (1 - f)], [0.0, f, cy * (1 - f)]])
+    return warped(img, m, cv2.INTER_LINEAR, cv2.BORDER_REPLICATE)
 
 
 def detection_box(detection) -> tuple[float, float, float, float]:

@@ -1,20 +1,12 @@
 """The DSST scale filter (iemd_ros/scale_filter.py) and the tracker's use of it."""
-import cv2
 import numpy as np
 import pytest
+from helpers import zoomed
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
 from iemd_ros.scale_filter import FLOOR, ScaleFilter, orientation_histograms
-
-
-def zoomed(frame, centre, factor):
-    """``frame`` magnified by ``factor`` about ``centre`` (the target grows by ``factor``)."""
-    cx, cy = centre
-    warp = np.array([[factor, 0.0, cx * (1 - factor)], [0.0, factor, cy * (1 - factor)]])
-    return cv2.warpAffine(frame, warp, (frame.shape[1], frame.shape[0]), flags=cv2.INTER_LINEAR,
-                          borderMode=cv2.BORDER_REPLICATE)
 
 
 def test_orientation_histograms_of_edges_by_hand():

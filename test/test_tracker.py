@@ -1,10 +1,9 @@
 """IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
 import dataclasses
 
-import cv2
 import numpy as np
 import pytest
-from helpers import shifted, texture
+from helpers import rotated, shifted, texture
 
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
@@ -97,11 +96,6 @@ def test_prior_moves_the_start_of_the_search():
     assert abs(r_prior.box[0] - 155.0) < 0.5
     assert abs(r_plain.box[0] - 155.0) > 5.0
     assert r_prior.predicted_box[0] == pytest.approx(155.0)
-
-
-def rotated(img, center, degrees):
-    m = cv2.getRotationMatrix2D((float(center[0]), float(center[1])), -degrees, 1.0)  # +: towards +y (image)
-    return cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), flags=cv2.INTER_CUBIC, borderMode=cv2.BORDER_REFLECT)
 
 
 def test_window_sampled_at_an_angle_undoes_an_image_rotation():
