@@ -168,20 +168,17 @@ class PipelineConfig:
 
     @classmethod
     def from_parameters(cls, params: dict) -> "PipelineConfig":
-        """From the node's ROS parameters: ``tracker.n_iter`` (dotted, as the node declares them) or a
-        group ``tracker: {n_iter: 10}`` (a parameter file may write either; a later key wins).  Node-only
-        parameters (``initial_box``, ``class_id``, ...) are ignored."""
+        """From the node's ROS parameters, by their dotted names as the node declares them (``tracker.n_iter``;
+        :meth:`from_yaml` flattens a file's groups ``tracker: {n_iter: 10}`` to them).  Node-only parameters
+        (``initial_box``, ``class_id``, ...) are ignored."""
         keys = {f.name for f in fields(cls)}
         values: dict = {"tracker": {}, "gyro": {}}
         for key, value in params.items():
             group, dot, name = str(key).partition(".")
             if group in ("tracker", "gyro"):
-                if dot:
-                    values[group][name] = value
-                elif isinstance(value, dict):
-                    values[group].update(value)
-                else:
+                if not dot:
                     raise ValueError(f"{group} must be a group of parameters ({group}.<name>), got {value!r}")
+                values[group][name] = value
             elif group in keys:
                 if dot:
                     raise ValueError(f"{group} is a single parameter, not a group: got {key!r}")
