@@ -88,7 +88,9 @@ def capture(name):
     converged, searches = np.zeros(len(CAPTURE_STARTS)), 0
     for k in np.linspace(0, len(seq) - 1, 6).astype(int):
         frame, truth = read_frame(seq.frame_paths[k]), np.asarray(seq.gt_boxes[k], dtype=float)
-        tracker = IemdTracker(TrackerConfig(n_particles=0, scale_step=0.0, update_templates=False))
+        # The EMD descent alone (Algorithm 1): no translation filter, whose start and check need a frame's estimate.
+        tracker = IemdTracker(TrackerConfig(n_particles=0, scale_step=0.0, translation_weight=0.0,
+                                            update_templates=False))
         tracker.init(frame, truth)
         pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(truth), truth[2:]
         for angle in np.linspace(0, 2 * np.pi, 8, endpoint=False):

@@ -80,6 +80,8 @@ _TRACKER_DOC = {
     "scale_range": ("emd: largest relative scale change per frame, [scale_step, 0.5)", (0.0, 0.499)),
     "flow_start": ("also start where the window's median optical flow moved it (section 6.1)", None),
     "flow_max_error": ("forward-backward error above which a flow point is dropped, px", (1e-3, 100.0)),
+    "translation_weight": ("weight of the translation filter's response against EMD / background EMD when "
+                           "choosing among the descended starts (0: no filter)", (0.0, 100.0)),
     "n_particles": ("extra starting points for abrupt motion (section 6.1)", (0, 64)),
     "particle_offset": ("distance of the extra starts from the prediction, window sizes", (0.0, 10.0)),
     "particle_trigger": ("run the extra starts when EMD > trigger x background EMD (0: always)", (0.0, 100.0)),

@@ -92,10 +92,7 @@ class ScaleFilter:
         peak = int(np.argmax(response))
         shift = peak - len(response) // 2
         if 0 < peak < len(response) - 1:
-            left, centre, right = response[peak - 1:peak + 2]
-            curvature = left - 2.0 * centre + right
-            if curvature < 0:
-                shift += 0.5 * (left - right) / curvature
+            shift += parabola_peak(*response[peak - 1:peak + 2])
         self._last = (spectrum, shift)
         return float(self.step**shift)
 
@@ -112,8 +109,7 @@ class ScaleFilter:
 
     # ------------------------------------------------------------ internals
     def _learn(self, spectrum: np.ndarray, shift: float):
-        desired = self._desired * np.exp(-1j * self._frequencies * shift)
-        return desired * np.conj(spectrum), (spectrum * np.conj(spectrum)).real.sum(0)
+        return filter_terms(self._desired * np.exp(-1j * self._frequencies * shift), spectrum, axis=0)
 
     def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
         """FFT along the scales of the (d, S) sample: per scale, the window at that scale resampled to the
@@ -121,6 +117,19 @@ class ScaleFilter:
         size = np.asarray(size, dtype=np.float64)
         windows = pyramid.sample_scales(center, size, self.model_size, self.factors, angle)
         return np.fft.fft(orientation_histograms(windows).T * self._taper, axis=1)
+
+
+def filter_terms(desired: np.ndarray, spectrum: np.ndarray, axis: int = -1):
+    """Numerator G conj(F_l) and denominator sum_l |F_l|^2 of a multi-channel correlation filter (DSST eq. 5)
+    learnt from the sample ``spectrum`` (channels along ``axis``) and the desired response ``desired``."""
+    return desired * np.conj(spectrum), (spectrum * np.conj(spectrum)).real.sum(axis)
+
+
+def parabola_peak(left: float, centre: float, right: float) -> float:
+    """Offset (in samples, within +-0.5) of the vertex of the parabola through three samples around a
+    maximum ``centre``; 0 when they are not concave."""
+    curvature = left - 2.0 * centre + right
+    return 0.5 * (left - right) / curvature if curvature < 0 else 0.0
 
 
 def orientation_histograms(windows: np.ndarray) -> np.ndarray:

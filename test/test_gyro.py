@@ -203,7 +203,8 @@ def test_still_bias_ignores_rejected_samples_and_refuses_a_moving_start():
 
 def test_real_desk_close_up_with_roll_is_tracked_with_the_gyro(imu_root):
     """CMU desk frames 500-580: the camera closes in on the eagle's head and rolls it by ~160 deg.
-    Measured: mean IoU 0.71 (min 0.63) with the gyro prior, the window turning to -160 deg; 0.17 without."""
+    Measured: mean IoU 0.73 (min 0.65) with the gyro prior, the window turning to -160 deg; without it 0.46,
+    the last 20 frames at most 0.30 (0.17 over all frames before the translation filter)."""
     from iemd_ros.recordings import load_recording, track_recording
 
     rec = load_recording(imu_root / "cmu_hwangbo_desk")
@@ -216,4 +217,4 @@ def test_real_desk_close_up_with_roll_is_tracked_with_the_gyro(imu_root):
     ious, angles = runs[True]
     assert ious.mean() > 0.6 and ious.min() > 0.4, ious
     assert angles.min() < -120.0          # the window turned with the roll
-    assert runs[False][0].mean() < 0.4    # without the gyro the close-up is lost
+    assert runs[False][0][-20:].max() < 0.4    # without the gyro the close-up is lost

@@ -73,9 +73,10 @@ def test_tracks_synthetic_shake_with_gyro_and_is_deterministic(seq):
 
 
 def test_without_gyro_the_shake_is_not_followed_and_the_reason_is_given(seq):
-    # The tracker's own search only: its flow start follows much of the shake by itself (max centre
-    # error 0.5 px with it when written), which is not what this test is about.
-    p = _pipeline(seq, use_gyro=False, tracker={"flow_start": False})
+    # The tracker's own search only: its flow start and its translation filter follow much of the shake by
+    # themselves (max centre error 0.5 px with the flow when written, 6.9 px with the filter), which is not
+    # what this test is about.
+    p = _pipeline(seq, use_gyro=False, tracker={"flow_start": False, "translation_weight": 0.0})
     _feed_imu(p, seq)
     p.set_camera(seq.camera)
     res = _run(p, seq)

@@ -85,7 +85,8 @@ def test_prior_moves_the_start_of_the_search():
     frame0 = texture(seed=2)
     box = (130.0, 90.0, 40.0, 40.0)
     frame1 = shifted(frame0, 25.0, 0.0)
-    config = TrackerConfig(scale_step=0, n_particles=0, flow_start=False, update_templates=False)
+    config = TrackerConfig(scale_step=0, n_particles=0, flow_start=False, translation_weight=0.0,
+                           update_templates=False)
     without = IemdTracker(config)
     without.init(frame0, box)
     with_prior = IemdTracker(config)
@@ -157,17 +158,19 @@ def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
     tracker.init(frame, (100.0, 80.0, 40.0, 40.0))
     solves.clear()
     result = tracker.update(shifted(frame, 3.0, 2.0))
-    assert result.starts == 2 + tracker.config.n_particles  # the prediction, the flow start, the particles
+    assert result.starts == 3 + tracker.config.n_particles  # prediction, flow, translation filter, particles
     assert result.solver_warnings == len(solves) > 0
 
 
 def test_the_particles_catch_a_jump_of_half_a_window(car4_first):
     """Section 6.1's particles (off by default, see TrackerConfig): Car4 moved by 0.45 window sizes, with
-    no flow start, is reached from the particle 0.5 window sizes to the right and missed without them."""
+    no flow start and no translation filter, is reached from the particle 0.5 window sizes to the right and
+    missed without them."""
     frame, box = car4_first
     jump = np.array([0.45 * box[2], 0.03 * box[3]])
     moved = shifted(frame, *jump)
-    config = TrackerConfig(scale_step=0, flow_start=False, particle_trigger=0.0, update_templates=False)
+    config = TrackerConfig(scale_step=0, flow_start=False, translation_weight=0.0, particle_trigger=0.0,
+                           update_templates=False)
     boxes = {}
     for n_particles in (0, 4):
         tracker = IemdTracker(dataclasses.replace(config, n_particles=n_particles))
