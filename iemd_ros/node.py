@@ -82,6 +82,8 @@ _TRACKER_DOC = {
     "flow_max_error": ("forward-backward error above which a flow point is dropped, px", (1e-3, 100.0)),
     "translation_weight": ("weight of the translation filter's response against EMD / background EMD when "
                            "choosing among the descended starts (0: no filter)", (0.0, 100.0)),
+    "descend_all_starts": ("with the translation filter, descend every start, not only the best by EMD and by score "
+                           "(about 1.8x the update time)", None),
     "n_particles": ("extra starting points for abrupt motion (section 6.1)", (0, 64)),
     "particle_offset": ("distance of the extra starts from the prediction, window sizes", (0.0, 10.0)),
     "particle_trigger": ("run the extra starts when EMD > trigger x background EMD (0: always)", (0.0, 100.0)),

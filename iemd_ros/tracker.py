@@ -71,13 +71,17 @@ class TrackerConfig:
     # 33.9 / 34.4 / 35.8 / 34.2 / 32.6 %; with the EMD scale variants 1 / 2 px scored 32.5 / 33.1 %.
     flow_max_error: float = 2.0
     # The discriminative check of the starts (iemd_ros/translation_filter.py).  A correlation filter trained on the
-    # target against its surroundings adds a start where its response peaks; every start is descended, and the
-    # window kept is the one of lowest EMD / background EMD - translation_weight x the filter's response there.
-    # 0: no filter, only the start of lowest EMD is descended (Algorithm 1 as before).  12 OTB sequences x 5
-    # starts (as for flow_start), mean average overlap: 40.0 % against 35.8 % without (CSRT 41.8 %).  Weights
-    # 0.5 / 2 scored 37.4 / 35.7 %, and descending every start but keeping the lowest EMD 34.9 % (these three with
-    # a prototype that also took the filter's start when it lay within min_step_px of the prediction).
+    # target against its surroundings adds a start where its response peaks.  The start of lowest EMD is descended
+    # (Algorithm 1), and so is the start of lowest score = EMD / background EMD - translation_weight x the filter's
+    # response there, when that is another one; the window of lower score is kept.  0: no filter.  12 OTB
+    # sequences x 5 starts (as for flow_start), mean average overlap: 38.1 % against 35.8 % without (CSRT 41.8 %),
+    # 8.2-9.6 candidate models per frame against 6.7-7.4 (Woman, Bolt2, David).
     translation_weight: float = 1.0
+    # Descend every start and keep the window of lowest score: 40.0 % over the same 60 runs, at 14.2-18.8 models
+    # per frame (about 1.8x the update time).  With it, weights 0.5 / 2 scored 37.4 / 35.7 %, keeping the lowest
+    # EMD instead of the lowest score 34.9 % (these three with a prototype that also took the filter's start within
+    # min_step_px of the prediction), and a minimum step of 1 px (fewer backtracking solves) 38.3 %.
+    descend_all_starts: bool = False
     # Then section 6.1's particles, n_particles windows particle_offset window sizes around the prediction.  Off
     # by default: with the flow start they lower the mean average overlap over the same 60 runs from 34.1 % to
     # 26.1 % (per start 40.5/32.0/38.7/30.0/29.5 % without them), 30.5-31.0 % when they run only on lost frames
@@ -357,8 +361,9 @@ class IemdTracker:
         """Coarse-to-fine Algorithm 1 from one or more starts (N, 2).
 
         ``fine_starts`` skip the coarse stage: the flow start, which pyramidal Lucas-Kanade already
-        placed coarse to fine, and the translation filter's.  Without the translation filter only the start of
-        lowest EMD is refined; with it every start is, and the window kept is the one of best :meth:`_score`.
+        placed coarse to fine, and the translation filter's.  The start of lowest EMD is refined, and with
+        the translation filter also the start of lowest :meth:`_score` (or every start: ``descend_all_starts``);
+        the refined window of lowest score is kept.
 
         The appearance EMD is minimal at the target, but its basin is only about
         as wide as the patches' texture is coarse (a few pixels for fine texture).
@@ -392,23 +397,26 @@ class IemdTracker:
             ends.append(start)
         models = [CandidateModel(fine, s, size) for s in (*ends, *fine_starts)]
         warnings += sum(_not_optimal(model.emd()[1]) for model in models)  # each model caches its EMD
-        if self._translation_filter is None:
-            descents = [self._descend(min(models, key=lambda model: model.emd()[0]))]
-        else:
-            descents = [self._descend(model) for model in models]
-        best = min(descents, key=self._score)
-        best.codings = len(models) + sum(d.codings for d in descents)
-        best.warnings = warnings + sum(d.warnings for d in descents)
+        chosen = [min(models, key=lambda model: model.emd()[0])]
+        if self._translation_filter is not None:
+            if self.config.descend_all_starts:
+                chosen = models
+            else:
+                checked = min(models, key=lambda model: self._score(model.emd()[0], model.center))
+                chosen += [checked] if checked is not chosen[0] else []
+        descents = [self._descend(model) for model in chosen]
+        best = min(descents, key=lambda state: self._score(state.emd, state.center))
+        best.codings = len(models) + sum(state.codings for state in descents)
+        best.warnings = warnings + sum(state.warnings for state in descents)
         return best
 
-    def _score(self, state: _Descent) -> float:
-        """What the search minimizes over its descended windows: the EMD, relative to the background EMD, less
-        ``translation_weight`` times the translation filter's response at the window's centre."""
+    def _score(self, emd: float, center) -> float:
+        """What the search minimizes: the EMD, and with the translation filter the EMD relative to the background
+        EMD less ``translation_weight`` times the filter's response at the window centre ``center``."""
         if self._translation_filter is None:
-            return state.emd
+            return emd
         background = self._background_emd if np.isfinite(self._background_emd) else 1.0
-        return state.emd / background - self.config.translation_weight * self._translation_filter.response_at(
-            state.center)
+        return emd / background - self.config.translation_weight * self._translation_filter.response_at(center)
 
     def _descend(self, model: CandidateModel) -> _Descent:
         """Algorithm 1 from the window of ``model``: move against dEMD/dy while the EMD decreases.
