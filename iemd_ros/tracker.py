@@ -76,8 +76,8 @@ class TrackerConfig:
     # response there, when that is another one; the window of lower score is kept.  0: no filter.  12 OTB
     # sequences x 5 starts (as for flow_start), mean average overlap: 38.1 % against 35.8 % without (CSRT 41.8 %),
     # 8.2-9.6 candidate models per frame against 6.7-7.4 (Woman, Bolt2, David).  Weights 0.7 / 1.5 scored 39.0 /
-    # 37.2 %, within the spread of such runs.  Keeping the template, the window size and both filters unchanged on
-    # frames whose response at the kept window is below 0.2 / 0.35 (against learning an occluder) scored 34.4 / 33.2 %.
+    # 37.2 %, within the spread of such runs.  Not updating the template and the two filters on frames whose
+    # response at the kept window is below 0.2 / 0.35 (against learning an occluder) scored 34.4 / 33.2 %.
     translation_weight: float = 1.0
     # Descend every start and keep the window of lowest score: 40.0 % over the same 60 runs, at 14.2-18.8 models
     # per frame (about 1.8x the update time).  With it, weights 0.5 / 2 scored 37.4 / 35.7 %, keeping the lowest
