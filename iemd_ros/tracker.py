@@ -42,7 +42,11 @@ class TrackerConfig:
     step_px: float = 2.0  # first step along the descent direction, image pixels
     min_step_px: float = 0.5  # stop when backtracking has halved the step below this
     gradient: str = "appearance"  # "appearance", "envelope" or "paper" (eq. 10): see CandidateModel.gradient
-    coarse_to_fine: bool = True  # first descend on the next pyramid level (wider convergence region)
+    # First descend from the prediction on the next pyramid level (a wider convergence region; see _search).  Off by
+    # default since the translation filter's start: 12 OTB sequences x 5 starts 38.6 % without the coarse stage
+    # against 38.1 % with it, and median updates 20-30 % shorter (Woman, Bolt2, David: 10.7 / 11.8 / 10.0 ms
+    # against 14.7 / 16.5 / 13.1 ms in one run; 10.8 / 13.5 / 11.7 ms for the coarse stage without the filter).
+    coarse_to_fine: bool = False
     # Scale at the converged position.  "filter": the DSST scale filter (iemd_ros/scale_filter.py), 33 scales
     # (1 + scale_step)**k, +-37 % per frame; "emd": the paper's EMD of the window scaled by 1 +- scale_step, stepping
     # on while the EMD decreases up to scale_range.  The EMD hardly sees scale (benchmarks/scale_curve.py); 12 OTB
@@ -375,7 +379,8 @@ class IemdTracker:
         gets the fine descent.  Measured (benchmarks/tune_tracker.py,
         Car4/Bolt2/Woman average overlap, with the defaults of the time): on
         36.2 %, off 34.9 % (it helps the panning Bolt2 and Woman, hurts the large
-        Car4).  With section 6.1's extra starting points, running the whole
+        Car4); since the translation filter it is off by default (TrackerConfig.coarse_to_fine).
+        With section 6.1's extra starting points, running the whole
         coarse-to-fine search from every start gave p95 update times of
         80-100 ms (5x a normal frame).
 
