@@ -15,8 +15,8 @@ the response peaks and keeps the response map, which ``response_at`` reads at an
 tracker (``TrackerConfig.translation_weight``) takes the displacement as one more start and the response
 as evidence against the EMD when it chooses among the descended starts.
 
-Choices, measured over the 12 OTB sequences x 5 starts (mean average overlap 40.0 % with these defaults,
-35.8 % without the filter): padding 1.5 (2.0: 38.1 %), learning rate 0.025 (0.05 / 0.012: 37.7 / 36.1 %),
+Choices, measured over the 12 OTB sequences x 5 starts with every start descended (mean average overlap
+40.0 % with these defaults, 35.8 % without the filter): padding 1.5 (2.0: 38.1 %), learning rate 0.025 (0.05 / 0.012: 37.7 / 36.1 %),
 sigma_factor 0.1 (DSST's 1/16: 35.8 %, 0.2: 38.0 %), model area 4096 px (2048 / 8192: 40.2 / 37.1 %).
 Estimate and update take about 1 ms per frame together.
 """
