@@ -56,8 +56,6 @@ class ScaleFilter:
             raise ValueError(f"n_scales must be odd and >= 3, got {n_scales}")
         if not scale_step > 1.0:
             raise ValueError(f"scale_step must be > 1, got {scale_step}")
-        if not 0.0 < learning_rate <= 1.0:
-            raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
         offsets = np.arange(n_scales) - n_scales // 2
         self.step = scale_step
         self.factors = scale_step ** offsets  # relative scales, ascending; the middle one is 1
@@ -66,12 +64,9 @@ class ScaleFilter:
         self._desired = np.fft.fft(np.exp(-0.5 * (offsets / sigma) ** 2))
         self._frequencies = 2.0 * np.pi * np.fft.fftfreq(n_scales)
         self._taper = np.hanning(n_scales + 2)[1:-1]  # Hann window over the scales (no zero ends)
-        self.learning_rate = learning_rate
-        self.regularization = regularization
         self.model_area = model_area
         self.model_size = None  # (w, h) of the resampled windows, multiples of CELL
-        self._numerator = None  # G conj(F), (d, S)
-        self._denominator = None  # sum_l |F_l|^2, (S,)
+        self._filter = FilterModel(learning_rate, regularization, channel_axis=0)  # spectra (d, S)
         self._last = None  # (spectrum, estimated shift in scale steps) of the last estimate
 
     def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
@@ -79,16 +74,17 @@ class ScaleFilter:
         w, h = (float(v) for v in size)
         f = np.sqrt(self.model_area / (w * h))
         self.model_size = tuple(int(max(2, round(v * f / CELL))) * CELL for v in (w, h))
-        self._numerator, self._denominator = self._learn(self._spectrum(pyramid, center, size, angle), 0.0)
+        self._filter.reset()
+        self._learn(self._spectrum(pyramid, center, size, angle), 0.0)
         self._last = None
 
     def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> float:
         """Relative scale of the target in ``pyramid``'s frame against the window ``size`` at ``center``: the
         factor where the filter response peaks, refined between scales by a parabola through the peak."""
-        if self._numerator is None:
+        if not self._filter.trained:
             raise RuntimeError("ScaleFilter.estimate() called before init()")
         spectrum = self._spectrum(pyramid, center, size, angle)
-        response = np.fft.ifft((self._numerator * spectrum).sum(0) / (self._denominator + self.regularization)).real
+        response = np.fft.ifft(self._filter.response(spectrum)).real
         peak = int(np.argmax(response))
         shift = peak - len(response) // 2
         if 0 < peak < len(response) - 1:
@@ -101,15 +97,12 @@ class ScaleFilter:
         peaked at the scale it estimated."""
         if self._last is None:
             raise RuntimeError("ScaleFilter.update() needs an estimate() first")
-        numerator, denominator = self._learn(*self._last)
-        eta = self.learning_rate
-        self._numerator = (1.0 - eta) * self._numerator + eta * numerator
-        self._denominator = (1.0 - eta) * self._denominator + eta * denominator
+        self._learn(*self._last)
         self._last = None
 
     # ------------------------------------------------------------ internals
-    def _learn(self, spectrum: np.ndarray, shift: float):
-        return filter_terms(self._desired * np.exp(-1j * self._frequencies * shift), spectrum, axis=0)
+    def _learn(self, spectrum: np.ndarray, shift: float) -> None:
+        self._filter.learn(self._desired * np.exp(-1j * self._frequencies * shift), spectrum)
 
     def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
         """FFT along the scales of the (d, S) sample: per scale, the window at that scale resampled to the
@@ -119,10 +112,40 @@ class ScaleFilter:
         return np.fft.fft(orientation_histograms(windows).T * self._taper, axis=1)
 
 
-def filter_terms(desired: np.ndarray, spectrum: np.ndarray, axis: int = -1):
-    """Numerator G conj(F_l) and denominator sum_l |F_l|^2 of a multi-channel correlation filter (DSST eq. 5)
-    learnt from the sample ``spectrum`` (channels along ``axis``) and the desired response ``desired``."""
-    return desired * np.conj(spectrum), (spectrum * np.conj(spectrum)).real.sum(axis)
+class FilterModel:
+    """A multi-channel correlation filter in the Fourier domain (DSST eq. 5), shared by the scale and the
+    translation filter: numerator G conj(F_l) and denominator sum_l |F_l|^2 of the samples learnt, as running
+    averages at ``learning_rate`` (the first sample replaces them), channels along ``channel_axis``."""
+
+    def __init__(self, learning_rate: float, regularization: float, channel_axis: int):
+        if not 0.0 < learning_rate <= 1.0:
+            raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
+        self.learning_rate = learning_rate
+        self.regularization = regularization
+        self.channel_axis = channel_axis
+        self.reset()
+
+    @property
+    def trained(self) -> bool:
+        return self._numerator is not None
+
+    def reset(self) -> None:
+        self._numerator = self._denominator = None
+
+    def learn(self, desired: np.ndarray, spectrum: np.ndarray) -> None:
+        """Blend in the sample ``spectrum`` with its desired response ``desired``."""
+        numerator = desired * np.conj(spectrum)
+        denominator = (spectrum * np.conj(spectrum)).real.sum(self.channel_axis)
+        if self._numerator is None:
+            self._numerator, self._denominator = numerator, denominator
+            return
+        eta = self.learning_rate
+        self._numerator = (1.0 - eta) * self._numerator + eta * numerator
+        self._denominator = (1.0 - eta) * self._denominator + eta * denominator
+
+    def response(self, spectrum: np.ndarray) -> np.ndarray:
+        """Spectrum of the filter's response to the sample ``spectrum`` (channels summed)."""
+        return (self._numerator * spectrum).sum(self.channel_axis) / (self._denominator + self.regularization)
 
 
 def parabola_peak(left: float, centre: float, right: float) -> float:

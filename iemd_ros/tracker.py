@@ -229,11 +229,12 @@ class IemdTracker:
         self._target_eps = self.layout.extract(template)  # epsilon_u of I_0 (Algorithm 1)
         self._refresh_target()
         self._background_emd = self._measure_background_emd(pyramid)
-        # Coarse stage: the target window one pyramid level smoother, weighted by the kernel only.
-        coarse_eps = self.layout.extract(pyramid.sample(self._center, self._size, cfg.template_size,
-                                                        coarse=_COARSE_LEVELS))
-        self._coarse_target = TargetModel.from_patches(self.layout.positions(), coarse_eps, np.ones(len(coarse_eps)),
-                                                       cfg.kernel_bandwidth)
+        self._coarse_target = None
+        if cfg.coarse_to_fine:  # the coarse stage's target: the window one pyramid level smoother, kernel weights only
+            coarse_eps = self.layout.extract(pyramid.sample(self._center, self._size, cfg.template_size,
+                                                            coarse=_COARSE_LEVELS))
+            self._coarse_target = TargetModel.from_patches(self.layout.positions(), coarse_eps,
+                                                           np.ones(len(coarse_eps)), cfg.kernel_bandwidth)
         self._scale_filter = None
         if cfg.scale_estimator == "filter" and cfg.scale_step > 0:
             self._scale_filter = ScaleFilter(scale_step=1.0 + cfg.scale_step)
@@ -313,12 +314,14 @@ class IemdTracker:
     def search_context(self, pyramid: ImagePyramid, angle: float = 0.0, coarse: bool = False) -> SearchContext:
         """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the current target model
         and dictionary, or (``coarse``) the coarse stage's: one pyramid level up, its own target, no sparse
-        coding.  Also for analysis: ``CandidateModel(tracker.search_context(pyramid), centre, size).emd()``
+        coding (``coarse_to_fine`` only).  Also for analysis: ``CandidateModel(tracker.search_context(pyramid), centre, size).emd()``
         scores any window against the target (benchmarks/model_ceiling.py, scale_curve.py)."""
         if self._center is None:
             raise RuntimeError("IemdTracker.search_context() called before init()")
         cfg = self.config
         if coarse:
+            if self._coarse_target is None:
+                raise RuntimeError("IemdTracker.search_context(coarse=True) needs coarse_to_fine")
             return SearchContext(pyramid, self.layout, self._coarse_target, None, cfg.alpha, cfg.kernel_bandwidth,
                                  coarse=_COARSE_LEVELS, angle=angle)
         return SearchContext(pyramid, self.layout, self._target, self.dictionary, cfg.alpha, cfg.kernel_bandwidth,

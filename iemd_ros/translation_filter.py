@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import ImagePyramid, window_axes
-from .scale_filter import CELL, filter_terms, orientation_histograms, parabola_peak
+from .scale_filter import CELL, FilterModel, orientation_histograms, parabola_peak
 
 
 class TranslationFilter:
@@ -39,16 +39,11 @@ class TranslationFilter:
                  sigma_factor: float = 0.1, model_area: int = 4096):
         if padding < 0:
             raise ValueError(f"padding must be >= 0, got {padding}")
-        if not 0.0 < learning_rate <= 1.0:
-            raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
         self.padding = padding
-        self.learning_rate = learning_rate
-        self.regularization = regularization
         self.sigma_factor = sigma_factor
         self.model_area = model_area
         self.model_size = None  # (w, h) of the resampled search region, multiples of CELL
-        self._numerator = None  # G conj(F), (rows, cols, d)
-        self._denominator = None  # sum_l |F_l|^2, (rows, cols)
+        self._filter = FilterModel(learning_rate, regularization, channel_axis=-1)  # spectra (rows, cols, d)
         self._response = None  # (response map, centre, cell size in image px, angle) of the last estimate
 
     def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
@@ -62,16 +57,16 @@ class TranslationFilter:
         ys, xs = np.arange(rows) - rows // 2, np.arange(cols) - cols // 2
         peak = np.exp(-0.5 * (ys[:, None] ** 2 + xs[None, :] ** 2) / sigma**2)
         self._desired = np.fft.fft2(np.fft.ifftshift(peak))[..., None]  # peak at cell (0, 0)
-        self._numerator, self._denominator = filter_terms(self._desired, self._spectrum(pyramid, center, size, angle))
+        self._filter.reset()
+        self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
         self._response = None
 
     def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> np.ndarray:
         """Displacement (dx, dy), image pixels, from ``center`` to where the response peaks in the region around
         the window (``center``, ``size``), refined between cells by a parabola through the peak."""
-        if self._numerator is None:
+        if not self._filter.trained:
             raise RuntimeError("TranslationFilter.estimate() called before init()")
-        spectrum = self._spectrum(pyramid, center, size, angle)
-        response = np.fft.ifft2((self._numerator * spectrum).sum(-1) / (self._denominator + self.regularization)).real
+        response = np.fft.ifft2(self._filter.response(self._spectrum(pyramid, center, size, angle))).real
         rows, cols = response.shape
         cell_px = np.asarray(size, dtype=np.float64) * (1.0 + self.padding) / [cols, rows]
         self._response = (response, np.asarray(center, dtype=np.float64), cell_px, angle)
@@ -99,10 +94,7 @@ class TranslationFilter:
 
     def update(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
         """Blend in a sample at the tracked window (the running average of DSST eq. 5)."""
-        numerator, denominator = filter_terms(self._desired, self._spectrum(pyramid, center, size, angle))
-        eta = self.learning_rate
-        self._numerator = (1.0 - eta) * self._numerator + eta * numerator
-        self._denominator = (1.0 - eta) * self._denominator + eta * denominator
+        self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
 
     def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
         """2-D FFT of the tapered (rows, cols, d) features of the search region around the window."""
