@@ -30,15 +30,10 @@ first frame's filter mixed in (against drift) scored 34.2 %, and 15.5 % scale er
 """
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from .appearance import ImagePyramid
-
-N_ORIENTATIONS = 9  # unsigned gradient orientation bins of the features
-CELL = 4  # feature cell size, model pixels
-FLOOR = 0.05  # added to a cell histogram's norm (gradient magnitudes in grey levels per pixel, [0, 1] scale)
-
+from .correlation_filter import CELL, FilterModel, orientation_histograms, parabola_peak
 
 class ScaleFilter:
     """DSST scale filter: ``init`` at the target's window, then per frame ``estimate`` and, when the
@@ -110,95 +105,3 @@ class ScaleFilter:
         size = np.asarray(size, dtype=np.float64)
         windows = pyramid.sample_scales(center, size, self.model_size, self.factors, angle)
         return np.fft.fft(orientation_histograms(windows).T * self._taper, axis=1)
-
-
-class FilterModel:
-    """A multi-channel correlation filter in the Fourier domain (DSST eq. 5), shared by the scale and the
-    translation filter: numerator G conj(F_l) and denominator sum_l |F_l|^2 of the samples learnt, as running
-    averages at ``learning_rate`` (the first sample replaces them), channels along ``channel_axis``."""
-
-    def __init__(self, learning_rate: float, regularization: float, channel_axis: int):
-        if not 0.0 < learning_rate <= 1.0:
-            raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
-        self.learning_rate = learning_rate
-        self.regularization = regularization
-        self.channel_axis = channel_axis
-        self.reset()
-
-    @property
-    def trained(self) -> bool:
-        return self._numerator is not None
-
-    def reset(self) -> None:
-        self._numerator = self._denominator = None
-
-    def learn(self, desired: np.ndarray, spectrum: np.ndarray) -> None:
-        """Blend in the sample ``spectrum`` with its desired response ``desired``."""
-        numerator = desired * np.conj(spectrum)
-        denominator = (spectrum * np.conj(spectrum)).real.sum(self.channel_axis)
-        if self._numerator is None:
-            self._numerator, self._denominator = numerator, denominator
-            return
-        eta = self.learning_rate
-        self._numerator = (1.0 - eta) * self._numerator + eta * numerator
-        self._denominator = (1.0 - eta) * self._denominator + eta * denominator
-
-    def response(self, spectrum: np.ndarray) -> np.ndarray:
-        """Spectrum of the filter's response to the sample ``spectrum`` (channels summed)."""
-        return (self._numerator * spectrum).sum(self.channel_axis) / (self._denominator + self.regularization)
-
-
-def parabola_peak(left: float, centre: float, right: float) -> float:
-    """Offset (in samples, within +-0.5) of the vertex of the parabola through three samples around a
-    maximum ``centre``; 0 when they are not concave."""
-    curvature = left - 2.0 * centre + right
-    return 0.5 * (left - right) / curvature if curvature < 0 else 0.0
-
-
-def orientation_histograms(windows: np.ndarray) -> np.ndarray:
-    """Per window of ``windows`` (S, H, W), its gradient-orientation histograms as one vector (S, d).
-
-    Central-difference gradients (one-sided at the border); unsigned orientations in ``N_ORIENTATIONS``
-    bins, weighted by the gradient magnitude, summed over CELL x CELL cells; each cell's histogram divided
-    by its L2 norm plus a floor (flat cells stay short): a HOG without blocks, invariant to brightness
-    and contrast.  H and W are multiples of CELL.
-    """
-    windows = np.ascontiguousarray(windows, dtype=np.float32)
-    n, h, w = windows.shape
-    if h % CELL or w % CELL:
-        raise ValueError(f"window size {w}x{h} is not a multiple of the {CELL} px cell")
-    return _orientation_histograms(windows).reshape(n, -1)
-
-
-_BOUNDARY_COS = np.cos(np.arange(N_ORIENTATIONS) * np.pi / N_ORIENTATIONS)
-_BOUNDARY_SIN = np.sin(np.arange(N_ORIENTATIONS) * np.pi / N_ORIENTATIONS)
-
-
-@numba.njit(cache=True)
-def _orientation_histograms(windows):
-    n, h, w = windows.shape
-    n_rows, n_cols = h // CELL, w // CELL
-    hist = np.zeros((n, n_rows, n_cols, N_ORIENTATIONS))
-    for k in range(n):
-        for y in range(h):
-            y0, y1 = max(y - 1, 0), min(y + 1, h - 1)
-            for x in range(w):
-                x0, x1 = max(x - 1, 0), min(x + 1, w - 1)
-                gx = (windows[k, y, x1] - windows[k, y, x0]) / (x1 - x0)
-                gy = (windows[k, y1, x] - windows[k, y0, x]) / (y1 - y0)
-                if gy < 0.0 or (gy == 0.0 and gx < 0.0):  # unsigned: fold onto [0, pi)
-                    gx, gy = -gx, -gy
-                b = 0  # the last bin boundary at or below the orientation
-                while b < N_ORIENTATIONS - 1 and gy * _BOUNDARY_COS[b + 1] >= gx * _BOUNDARY_SIN[b + 1]:
-                    b += 1
-                hist[k, y // CELL, x // CELL, b] += np.sqrt(gx * gx + gy * gy)
-    for k in range(n):
-        for r in range(n_rows):
-            for c in range(n_cols):
-                norm = 0.0
-                for b in range(N_ORIENTATIONS):
-                    norm += hist[k, r, c, b] ** 2
-                scale = 1.0 / (np.sqrt(norm) + FLOOR)
-                for b in range(N_ORIENTATIONS):
-                    hist[k, r, c, b] *= scale
-    return hist

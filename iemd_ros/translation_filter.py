@@ -8,7 +8,7 @@ correlation filter is trained on the target against its own surroundings, the co
 
 The filter is DSST's translation filter (Danelljan et al., BMVC 2014; MOSSE with several channels):
 the window padded by ``padding`` on each axis is resampled to about ``model_area`` pixels and
-described by the gradient-orientation histograms of :func:`iemd_ros.scale_filter.orientation_histograms`
+described by the gradient-orientation histograms of :func:`iemd_ros.correlation_filter.orientation_histograms`
 (cells of 4 model pixels), tapered by a Hann window; the desired response is a Gaussian of ``sigma_factor``
 times the target's size (in cells) at the window centre.  ``estimate`` gives the displacement where
 the response peaks and keeps the response map, which ``response_at`` reads at any window centre.  The
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import ImagePyramid, window_axes
-from .scale_filter import CELL, FilterModel, orientation_histograms, parabola_peak
+from .correlation_filter import CELL, FilterModel, orientation_histograms, parabola_peak
 
 
 class TranslationFilter:

@@ -6,29 +6,7 @@ from helpers import zoomed
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
-from iemd_ros.scale_filter import FLOOR, ScaleFilter, orientation_histograms
-
-
-def test_orientation_histograms_of_edges_by_hand():
-    """A vertical step edge 0 -> 1 between columns 3 and 4 of a 4x8 window: central differences give
-    0.5 at columns 3 and 4 (horizontal gradient, orientation 0: bin 0), so each 4x4 cell holds 4 x 0.5 = 2
-    in bin 0, divided by 2 + FLOOR.  The reversed edge falls in the same (unsigned) bin; a horizontal edge
-    (orientation 90 degrees) in bin 4 (20-degree bins); a diagonal ramp (45 degrees) in bin 2."""
-    step = np.zeros((4, 8), np.float32)
-    step[:, 4:] = 1.0
-    expected = np.zeros((2, 9))
-    expected[:, 0] = 2.0 / (2.0 + FLOOR)
-    out = orientation_histograms(np.stack([step, 1.0 - step]))
-    np.testing.assert_allclose(out, np.stack([expected.ravel()] * 2), rtol=1e-6)
-
-    horizontal = np.zeros((8, 4), np.float32)
-    horizontal[4:] = 1.0
-    assert np.flatnonzero(orientation_histograms(horizontal[None]).reshape(2, 9).sum(0)).tolist() == [4]
-    ramp = np.add.outer(np.arange(8.0), np.arange(8.0)).astype(np.float32)[None] / 16.0
-    assert np.flatnonzero(orientation_histograms(ramp).reshape(4, 9).sum(0)).tolist() == [2]
-    assert not orientation_histograms(np.full((1, 8, 8), 0.5, np.float32)).any()  # flat: no gradient, zeros
-    with pytest.raises(ValueError, match="multiple of the 4 px cell"):
-        orientation_histograms(np.zeros((1, 6, 8), np.float32))
+from iemd_ros.scale_filter import ScaleFilter
 
 
 def test_the_scaled_windows_are_the_windows_sampled_one_by_one(car4_first):

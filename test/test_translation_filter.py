@@ -6,7 +6,7 @@ from helpers import shifted
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.appearance import ImagePyramid, to_gray
 from iemd_ros.boxes import box_centre
-from iemd_ros.scale_filter import CELL, parabola_peak
+from iemd_ros.correlation_filter import CELL
 from iemd_ros.translation_filter import TranslationFilter
 
 
@@ -56,13 +56,6 @@ def test_update_learns_the_tracked_window(car4_first):
     new_centre = centre + translation_filter.estimate(moved, centre, size)
     translation_filter.update(moved, new_centre, size)
     assert np.linalg.norm(translation_filter.estimate(moved, new_centre, size)) < 0.5
-
-
-def test_parabola_peak_by_hand():
-    """Samples of y = -(x - 0.25)^2 at -1, 0, 1 have their vertex at 0.25; a flat or convex triple gives 0."""
-    assert parabola_peak(-1.5625, -0.0625, -0.5625) == pytest.approx(0.25)
-    assert parabola_peak(1.0, 1.0, 1.0) == 0.0
-    assert parabola_peak(1.0, 0.0, 1.0) == 0.0
 
 
 def test_invalid_use_is_refused():
