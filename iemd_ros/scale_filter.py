@@ -35,6 +35,7 @@ import numpy as np
 from .appearance import ImagePyramid
 from .correlation_filter import CELL, FilterModel, orientation_histograms, parabola_peak
 
+
 class ScaleFilter:
     """DSST scale filter: ``init`` at the target's window, then per frame ``estimate`` and, when the
     frame is tracked, ``update``.
