@@ -15,7 +15,11 @@ SPAMS does not build here.  The active set (Lawson-Hanson on the quadratic
 program ``a'Ga - 2(b - lambda/2)'a``) terminates with the exact solution, so
 the KKT conditions hold to rounding, and it is fastest for sparse codes.  With
 the residual updated row-wise in place it codes 49 patches in 0.4 ms against
-147 atoms (L = 3) and 0.1 ms against 49 atoms (L = 1, the default).
+147 atoms (L = 3) and 0.1 ms against 49 atoms (L = 1, the default).  Extending the
+Cholesky factor of the active block by a row per entering atom, instead of
+factoring the block anew at every solve, made it 1.9x faster (0.27 -> 0.14 ms per
+49 patches x 49 atoms, 60 real windows of Woman/Bolt2/Car4, same codes to 2e-14;
+the coding was a quarter of the tracker's update time).
 
 lambda (the paper gives no value; the tracker's default is 0.1): with zero-mean
 unit patches and 3 templates (147 atoms), lambda = 0.01 gave 35 non-zeros per
@@ -31,46 +35,32 @@ import numpy as np
 
 
 @numba.njit(cache=True)
-def _cholesky_solve(m, rhs, out, k):
-    """Solve m[:k,:k] x = rhs[:k] for symmetric positive definite m, in place (no allocation)."""
-    for j in range(k):
-        d = m[j, j]
-        for p in range(j):
-            d -= m[j, p] * m[j, p]
-        d = np.sqrt(max(d, 1e-12))
-        m[j, j] = d
-        for i in range(j + 1, k):
-            v = m[i, j]
-            for p in range(j):
-                v -= m[i, p] * m[j, p]
-            m[i, j] = v / d
-    for i in range(k):
-        v = rhs[i]
-        for p in range(i):
-            v -= m[i, p] * out[p]
-        out[i] = v / m[i, i]
-    for i in range(k - 1, -1, -1):
-        v = out[i]
-        for p in range(i + 1, k):
-            v -= m[p, i] * out[p]
-        out[i] = v / m[i, i]
+def _factor_append(chol, order, k, j, gram, ridge):
+    """Extend the lower Cholesky factor of G[order[:k], order[:k]] + ridge I by atom j (row/column k)."""
+    d = gram[j, j] + ridge
+    for r in range(k):
+        v = gram[order[r], j]
+        for p in range(r):
+            v -= chol[r, p] * chol[k, p]
+        v /= chol[r, r]
+        chol[k, r] = v
+        d -= v * v
+    chol[k, k] = np.sqrt(max(d, 1e-12))
 
 
 @numba.njit(cache=True)
-def _solve_active(gram, b, active, idx, sub, rhs, z, ridge):
-    """z = G_PP^-1 b_P on the active set P (listed in idx[:k]); returns k."""
-    k = 0
-    for j in range(active.size):
-        if active[j]:
-            idx[k] = j
-            k += 1
-    for r in range(k):
-        rhs[r] = b[idx[r]]
-        for c in range(k):
-            sub[r, c] = gram[idx[r], idx[c]]
-        sub[r, r] += ridge
-    _cholesky_solve(sub, rhs, z, k)
-    return k
+def _factor_solve(chol, order, k, b, z):
+    """z = (L L')^-1 b[order[:k]] (forward then back substitution)."""
+    for i in range(k):
+        v = b[order[i]]
+        for p in range(i):
+            v -= chol[i, p] * z[p]
+        z[i] = v / chol[i, i]
+    for i in range(k - 1, -1, -1):
+        v = z[i]
+        for p in range(i + 1, k):
+            v -= chol[p, i] * z[p]
+        z[i] = v / chol[i, i]
 
 
 @numba.njit(cache=True)
@@ -78,7 +68,9 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
     """Exact non-negative lasso for every column of ``correlations`` (= Phi' E).
 
     Lawson-Hanson active set on the quadratic program a'Ga - 2(b - lambda/2)'a,
-    from an empty support.  (Starting from the support of the target patch's
+    from an empty support.  The Cholesky factor of the active block is extended by
+    one row when an atom enters (O(k^2)) and rebuilt only when the step toward the
+    new solution drops atoms.  (Starting from the support of the target patch's
     code gave the same codes 10 % slower: a window moved by a pixel codes
     onto different atoms, and the wrong guesses cost solves to prune.)
     ``ridge`` (1e-10) keeps the active sub-system solvable when two atoms are
@@ -89,23 +81,26 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
     codes = np.zeros((n_atoms, n_signals))
     half_lam = 0.5 * lam
     active = np.zeros(n_atoms, dtype=np.bool_)
-    idx = np.empty(n_atoms, dtype=np.int64)
-    sub = np.empty((n_atoms, n_atoms))
-    rhs = np.empty(n_atoms)
+    order = np.empty(n_atoms, dtype=np.int64)
+    chol = np.zeros((n_atoms, n_atoms))
+    a = np.zeros(n_atoms)
+    b = np.empty(n_atoms)
+    w = np.empty(n_atoms)
     z = np.empty(n_atoms)
-    a = np.empty(n_atoms)
-    w = np.empty(n_atoms)  # half the negative gradient of the objective at a
     for n in range(n_signals):
-        b = correlations[:, n] - half_lam
-        a[:] = 0.0
-        active[:] = False
+        for j in range(n_atoms):
+            b[j] = correlations[j, n] - half_lam
+            a[j] = 0.0
+            active[j] = False
+        k = 0
         for _ in range(3 * n_atoms):
-            w[:] = b
-            for r in range(n_atoms):  # w = b - G a over the non-zeros (G symmetric: rows)
-                if a[r] != 0.0:
-                    ar = a[r]
-                    for j in range(n_atoms):
-                        w[j] -= gram[r, j] * ar
+            for j in range(n_atoms):
+                w[j] = b[j]
+            for r in range(k):
+                row = order[r]
+                ar = a[row]
+                for j in range(n_atoms):
+                    w[j] -= gram[row, j] * ar
             j_best = -1
             w_best = tol
             for j in range(n_atoms):
@@ -114,32 +109,42 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
                     j_best = j
             if j_best < 0:
                 break
+            _factor_append(chol, order, k, j_best, gram, ridge)
+            order[k] = j_best
             active[j_best] = True
+            k += 1
             while True:
-                k = _solve_active(gram, b, active, idx, sub, rhs, z, ridge)
+                _factor_solve(chol, order, k, b, z)
                 feasible = True
                 for r in range(k):
                     if z[r] <= 0.0:
                         feasible = False
                 if feasible:
-                    a[:] = 0.0
                     for r in range(k):
-                        a[idx[r]] = z[r]
+                        a[order[r]] = z[r]
                     break
-                # Step from a toward z until the first coefficient hits zero.
                 alpha = 1.0
                 for r in range(k):
                     if z[r] <= 0.0:
-                        ratio = a[idx[r]] / (a[idx[r]] - z[r])
+                        ratio = a[order[r]] / (a[order[r]] - z[r])
                         if ratio < alpha:
                             alpha = ratio
+                kept = 0
                 for r in range(k):
-                    j = idx[r]
+                    j = order[r]
                     a[j] += alpha * (z[r] - a[j])
                     if a[j] <= 1e-14:
                         a[j] = 0.0
                         active[j] = False
-        codes[:, n] = a
+                    else:
+                        order[kept] = j
+                        kept += 1
+                k = 0
+                for r in range(kept):
+                    _factor_append(chol, order, k, order[r], gram, ridge)
+                    k += 1
+        for j in range(n_atoms):
+            codes[j, n] = a[j]
     return codes
 
 
