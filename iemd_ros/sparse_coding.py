@@ -94,7 +94,7 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
             active[j] = False
         k = 0
         for _ in range(3 * n_atoms):
-            for j in range(n_atoms):
+            for j in range(n_atoms):  # w = b - G a (half the negative gradient), G symmetric: rows of the support
                 w[j] = b[j]
             for r in range(k):
                 row = order[r]
@@ -107,7 +107,7 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
                 if not active[j] and w[j] > w_best:
                     w_best = w[j]
                     j_best = j
-            if j_best < 0:
+            if j_best < 0:  # KKT holds: no atom outside the support would lower the objective
                 break
             _factor_append(chol, order, k, j_best, gram, ridge)
             order[k] = j_best
@@ -123,6 +123,7 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
                     for r in range(k):
                         a[order[r]] = z[r]
                     break
+                # Step from a toward z until the first coefficient hits zero; drop those and refactor.
                 alpha = 1.0
                 for r in range(k):
                     if z[r] <= 0.0:
