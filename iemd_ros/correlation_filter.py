@@ -3,7 +3,8 @@
 * :class:`FilterModel`: a multi-channel correlation filter in the Fourier domain (DSST eq. 5) learnt as a
   running average;
 * :func:`orientation_histograms`: the features, gradient-orientation histograms on CELL x CELL cells;
-* :func:`parabola_peak`: a response's peak refined between samples.
+* :func:`parabola_peak`: a response's peak refined between samples;
+* :func:`model_size` and :func:`hann`: the resampled window and the taper of the features.
 """
 from __future__ import annotations
 
@@ -49,6 +50,19 @@ class FilterModel:
     def response(self, spectrum: np.ndarray) -> np.ndarray:
         """Spectrum of the filter's response to the sample ``spectrum`` (channels summed)."""
         return (self._numerator * spectrum).sum(self.channel_axis) / (self._denominator + self.regularization)
+
+
+def model_size(size, area: float, min_cells: int) -> tuple[int, int]:
+    """(w, h) in model pixels of a window of ``size`` resampled to about ``area`` pixels with its aspect ratio,
+    whole CELLs and at least ``min_cells`` of them per axis."""
+    w, h = (float(v) for v in size)
+    f = np.sqrt(area / (w * h))
+    return tuple(int(max(min_cells, round(v * f / CELL))) * CELL for v in (w, h))
+
+
+def hann(n: int) -> np.ndarray:
+    """Hann window of ``n`` samples without its zero ends (every sample keeps some weight)."""
+    return np.hanning(n + 2)[1:-1]
 
 
 def parabola_peak(left: float, centre: float, right: float) -> float:

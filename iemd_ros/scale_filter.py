@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import ImagePyramid
-from .correlation_filter import CELL, FilterModel, orientation_histograms, parabola_peak
+from .correlation_filter import FilterModel, hann, model_size, orientation_histograms, parabola_peak
 
 
 class ScaleFilter:
@@ -59,7 +59,7 @@ class ScaleFilter:
         # peaked at the middle, and the frequencies that shift it.
         self._desired = np.fft.fft(np.exp(-0.5 * (offsets / sigma) ** 2))
         self._frequencies = 2.0 * np.pi * np.fft.fftfreq(n_scales)
-        self._taper = np.hanning(n_scales + 2)[1:-1]  # Hann window over the scales (no zero ends)
+        self._taper = hann(n_scales)  # over the scales
         self.model_area = model_area
         self.model_size = None  # (w, h) of the resampled windows, multiples of CELL
         self._filter = FilterModel(learning_rate, regularization, channel_axis=0)  # spectra (d, S)
@@ -67,9 +67,7 @@ class ScaleFilter:
 
     def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
         """Learn the filter from the window (``center``, ``size``) of the first frame."""
-        w, h = (float(v) for v in size)
-        f = np.sqrt(self.model_area / (w * h))
-        self.model_size = tuple(int(max(2, round(v * f / CELL))) * CELL for v in (w, h))
+        self.model_size = model_size(size, self.model_area, min_cells=2)
         self._filter.reset()
         self._learn(self._spectrum(pyramid, center, size, angle), 0.0)
         self._last = None

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .appearance import ImagePyramid, window_axes
-from .correlation_filter import CELL, FilterModel, orientation_histograms, parabola_peak
+from .correlation_filter import CELL, FilterModel, hann, model_size, orientation_histograms, parabola_peak
 
 
 class TranslationFilter:
@@ -48,11 +48,10 @@ class TranslationFilter:
 
     def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
         """Learn the filter from the window (``center``, ``size``) of the first frame."""
-        w, h = (float(v) * (1.0 + self.padding) for v in size)
-        f = np.sqrt(self.model_area / (w * h))
-        self.model_size = tuple(int(max(4, round(v * f / CELL))) * CELL for v in (w, h))
+        self.model_size = model_size(np.asarray(size, dtype=np.float64) * (1.0 + self.padding), self.model_area,
+                                     min_cells=4)
         cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
-        self._taper = np.outer(np.hanning(rows + 2)[1:-1], np.hanning(cols + 2)[1:-1])[..., None]
+        self._taper = np.outer(hann(rows), hann(cols))[..., None]
         sigma = self.sigma_factor * np.sqrt(cols * rows) / (1.0 + self.padding)
         ys, xs = np.arange(rows) - rows // 2, np.arange(cols) - cols // 2
         peak = np.exp(-0.5 * (ys[:, None] ** 2 + xs[None, :] ** 2) / sigma**2)

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from iemd_ros.correlation_filter import FLOOR, FilterModel, orientation_histograms, parabola_peak
+from iemd_ros.correlation_filter import FLOOR, FilterModel, hann, model_size, orientation_histograms, parabola_peak
 
 
 def test_orientation_histograms_of_edges_by_hand():
@@ -65,3 +65,12 @@ def test_filter_model_keeps_running_averages_at_its_learning_rate():
     assert not model.trained
     with pytest.raises(ValueError, match="learning_rate"):
         FilterModel(learning_rate=0.0, regularization=0.01, channel_axis=0)
+
+
+def test_model_size_and_taper_by_hand():
+    """100 x 50 px to about 512 px: scaled by sqrt(512 / 5000) = 0.32 to 32 x 16, whole 4-px cells; a tiny window
+    keeps min_cells cells per axis.  The taper has no zero ends and peaks in the middle."""
+    assert model_size((100.0, 50.0), 512, min_cells=2) == (32, 16)
+    assert model_size((4.0, 400.0), 512, min_cells=2) == (8, 228)
+    taper = hann(5)
+    np.testing.assert_allclose(taper, [0.25, 0.75, 1.0, 0.75, 0.25])
