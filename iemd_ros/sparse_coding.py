@@ -14,11 +14,12 @@ is highly coherent, so first-order methods crawl); scikit-learn's
 SPAMS does not build here.  The active set (Lawson-Hanson on the quadratic
 program ``a'Ga - 2(b - lambda/2)'a``) terminates with the exact solution, so
 the KKT conditions hold to rounding, and it is fastest for sparse codes.  With
-the residual updated row-wise in place it codes 49 patches in 0.4 ms against
-147 atoms (L = 3) and 0.1 ms against 49 atoms (L = 1, the default).  Extending the
+the residual updated row-wise in place it coded 49 patches in 0.4 ms against
+147 atoms (L = 3) and 0.1 ms against 49 atoms (L = 1, the default) on a lightly
+loaded day.  Extending the
 Cholesky factor of the active block by a row per entering atom, instead of
 factoring the block anew at every solve, made it 1.9x faster (0.27 -> 0.14 ms per
-49 patches x 49 atoms, 60 real windows of Woman/Bolt2/Car4, same codes to 2e-14;
+49 patches x 49 atoms on a loaded day, 60 real windows of Woman/Bolt2/Car4, same codes to 2e-14;
 the coding was a quarter of the tracker's update time).
 
 lambda (the paper gives no value; the tracker's default is 0.1): with zero-mean
