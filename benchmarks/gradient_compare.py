@@ -16,9 +16,7 @@ import argparse
 import numpy as np
 
 from iemd_ros import IemdTracker
-from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.boxes import box_centre
-from iemd_ros.candidate import CandidateModel
+from iemd_ros.boxes import box_centre, centre_box
 from iemd_ros.otb import default_root, load_sequence, read_frame
 
 GRADIENTS = ("paper", "envelope", "appearance")
@@ -37,19 +35,17 @@ def main():
         seq = load_sequence(name, default_root())
         for k in np.linspace(5, len(seq) - 1, 6).astype(int):
             prev, cur = read_frame(seq.frame_paths[k - 1]), read_frame(seq.frame_paths[k])
-            pyramid = ImagePyramid(to_gray(cur))
             truth, size = box_centre(seq.gt_boxes[k]), np.asarray(seq.gt_boxes[k][2:], dtype=float)
             offsets = rng.uniform(-args.offset, args.offset, (args.starts, 2))
             tracker = IemdTracker()
             tracker.init(prev, seq.gt_boxes[k - 1])
-            context = tracker.search_context(pyramid)
             for offset in offsets:
-                start = CandidateModel(context, truth + offset, size)  # one start model for all three
+                start = centre_box(truth + offset, size)
                 for gradient in GRADIENTS:
                     tracker.config.gradient = gradient  # only the descent reads it
-                    state = tracker._descend(start)
-                    errors[gradient].append(np.linalg.norm(state.center - truth))
-                    iterations[gradient].append(state.iterations)
+                    result = tracker.descend(cur, start)
+                    errors[gradient].append(np.linalg.norm(box_centre(result.box) - truth))
+                    iterations[gradient].append(result.iterations)
     print(f"starts up to {args.offset} px from the ground truth, {len(errors['paper'])} per gradient")
     for g in GRADIENTS:
         e = np.array(errors[g])

@@ -9,12 +9,11 @@ For every ``stride``-th frame k, with the target model of frame 1 (no template u
   offsets within +-0.6 window sizes of the ground truth; its IoU with the ground truth.  Scores: the
   EMD of iEMD, and as a peer the negative normalized cross-correlation (NCC) of the frame-1 window
   resampled to the template size.  This is what a perfect search could reach with the model.
-* one step: the tracker started from the ground truth of frame k - ``jump`` and updated on frame k
-  (IoU with the ground truth of k), against staying at the start.
+* one descent: Algorithm 1 (``IemdTracker.descend``) on frame k from the ground truth of frame
+  k - ``jump`` (IoU with the ground truth of k), against staying at the start.
 * capture range (``--capture``): on 6 frames per sequence, a tracker initialized on that frame (an
-  exact model) searches the same frame from starts 0.05-0.4 window sizes away from the target in 8
-  directions (coarse-to-fine descent, no particles or scale search); the share of starts that end
-  within 0.05 window sizes of it.
+  exact model) descends on the same frame from starts 0.05-0.4 window sizes away from the target in 8
+  directions; the share of starts that end within 0.05 window sizes of it.
 
 All other numbers are mean IoU in %.
 """
@@ -25,9 +24,9 @@ from multiprocessing import Pool
 
 import numpy as np
 
-from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros import IemdTracker
 from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.boxes import box_centre
+from iemd_ros.boxes import box_centre, centre_box
 from iemd_ros.candidate import CandidateModel
 from iemd_ros.metrics import iou
 from iemd_ros.evaluation import sequence_names
@@ -56,7 +55,7 @@ def measure(job):
     name, stride, jump = job
     seq = load_sequence(name, default_root())
     first = read_frame(seq.frame_paths[0])
-    tracker = IemdTracker(TrackerConfig(update_templates=False))
+    tracker = IemdTracker()  # descend() and search_context() leave the frame-1 model as it is
     tracker.init(first, seq.gt_boxes[0])
     template_size = tracker.config.template_size
     reference = tracker.dictionary.templates[0].ravel()  # the frame-1 window init() sampled (never updated here)
@@ -75,8 +74,7 @@ def measure(job):
             return -np.corrcoef(reference, window)[0, 1]
 
         start = np.asarray(seq.gt_boxes[k - jump], dtype=float)
-        tracker._center, tracker._size, tracker._angle, tracker._lost = box_centre(start), start[2:].copy(), 0.0, False
-        stepped = tracker.update(frame).box
+        stepped = tracker.descend(frame, start).box
         rows.append((_grid_argmin_iou(emd, truth), _grid_argmin_iou(ncc, truth),
                      iou(np.array([stepped]), truth[None])[0], iou(start[None], truth[None])[0]))
     return name, 100.0 * np.mean(rows, axis=0)
@@ -88,15 +86,14 @@ def capture(name):
     converged, searches = np.zeros(len(CAPTURE_STARTS)), 0
     for k in np.linspace(0, len(seq) - 1, 6).astype(int):
         frame, truth = read_frame(seq.frame_paths[k]), np.asarray(seq.gt_boxes[k], dtype=float)
-        # The EMD descent alone (Algorithm 1): no translation filter, whose start and check need a frame's estimate.
-        tracker = IemdTracker(TrackerConfig(n_particles=0, scale_step=0.0, translation_weight=0.0,
-                                            update_templates=False))
+        tracker = IemdTracker()
         tracker.init(frame, truth)
-        pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(truth), truth[2:]
+        centre, size = box_centre(truth), truth[2:]
         for angle in np.linspace(0, 2 * np.pi, 8, endpoint=False):
             direction = np.array([np.cos(angle), np.sin(angle)])
             for i, distance in enumerate(CAPTURE_STARTS):
-                end = tracker._search(pyramid, (centre + distance * size * direction)[None], size, 0.0).center
+                start = centre_box(centre + distance * size * direction, size)
+                end = box_centre(tracker.descend(frame, start).box)
                 converged[i] += np.linalg.norm((end - centre) / size) < 0.05
             searches += 1
     return name, 100.0 * converged / searches
@@ -114,7 +111,7 @@ def main():
     jobs = [(name, args.stride, args.jump) for name in names]
     with Pool(args.jobs) as pool:
         results = pool.map(measure, jobs)
-    print(f"{'sequence':14s} {'grid EMD':>9s} {'grid NCC':>9s} {'step iEMD':>10s} {'stay':>6s}   (mean IoU %)")
+    print(f"{'sequence':14s} {'grid EMD':>9s} {'grid NCC':>9s} {'descent':>10s} {'stay':>6s}   (mean IoU %)")
     for name, values in results:
         print(f"{name:14s} {values[0]:9.1f} {values[1]:9.1f} {values[2]:10.1f} {values[3]:6.1f}")
     mean = np.mean([values for _, values in results], axis=0)

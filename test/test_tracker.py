@@ -80,6 +80,26 @@ def test_recovers_a_translation_of_a_real_texture(car4_first):
     assert abs(result.box[0] - (x + 3.3)) < 0.75 and abs(result.box[1] - (y - 2.2)) < 0.75, result.box
 
 
+def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
+    """descend() converges from a start 3 px off on a shifted texture, and the next update() gives exactly
+    what a tracker that never descended gives."""
+    frame0 = texture(seed=1, blob=8)
+    box = (130.0, 90.0, 48.0, 40.0)
+    frame1 = shifted(frame0, 2.4, -1.7)
+    probed, untouched = IemdTracker(), IemdTracker()
+    probed.init(frame0, box)
+    untouched.init(frame0, box)
+    result = probed.descend(frame1, (box[0] + 2.4 - 3.0, box[1] - 1.7 + 1.0, 48.0, 40.0))
+    assert abs(result.box[0] - (box[0] + 2.4)) < 0.5 and abs(result.box[1] - (box[1] - 1.7)) < 0.5, result.box
+    assert result.box[2:] == (48.0, 40.0) and result.iterations > 0 and not result.lost
+    assert result.codings == 1 + result.iterations  # the start and each trial step
+    assert probed.update(frame1) == untouched.update(frame1)
+    with pytest.raises(RuntimeError, match="before init"):
+        IemdTracker().descend(frame1, box)
+    with pytest.raises(ValueError, match="outside"):
+        probed.descend(frame1, (-80.0, 10.0, 20.0, 20.0))
+
+
 def test_prior_moves_the_start_of_the_search():
     """A 25 px jump is outside the convergence region; the right prior brings it back."""
     frame0 = texture(seed=2)
