@@ -94,7 +94,9 @@ class TrackerConfig:
     # Descend every start and keep the window of lowest score: 40.0 % over the same 60 runs, at 14.2-18.8 models
     # per frame (about 1.8x the update time).  With it, weights 0.5 / 2 scored 37.4 / 35.7 %, keeping the lowest
     # EMD instead of the lowest score 34.9 % (these three with a prototype that also took the filter's start within
-    # min_step_px of the prediction), and a minimum step of 1 px (fewer backtracking solves) 38.3 %.
+    # min_step_px of the prediction), and a minimum step of 1 px (fewer backtracking solves) 38.3 %.  With the
+    # defaults of 2026-11-23 (the scale filter's window not solved again, the faster lasso) it scored 36.6 %
+    # against 38.6 % for the default.
     descend_all_starts: bool = False
     # Then section 6.1's particles, n_particles windows particle_offset window sizes around the prediction.  Off
     # by default: with the flow start they lower the mean average overlap over the same 60 runs from 34.1 % to
