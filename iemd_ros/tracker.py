@@ -43,12 +43,12 @@ class TrackerConfig:
     min_step_px: float = 0.5  # stop when backtracking has halved the step below this
     # Descent direction of Algorithm 1: "appearance" (the derivative of the re-sampled model Algorithm 1 evaluates),
     # "envelope" or "paper" (eq. 10: the duals times dw_C/dy, patches fixed); see CandidateModel.gradient.  On a
-    # frame shifted by a known offset, descents from up to 3 px off end within 0.5 px of it in 73.6 % of the starts
-    # with "appearance", 17.4 % with "paper" or "envelope" (benchmarks/gradient_compare.py, 144 starts).  In tracking they tie:
-    # 12 OTB sequences x 5 starts (the ground truth and 10 % off along the diagonals) 38.6 / 39.1 / 35.8 %, 4 more
-    # starts 10 % off along the axes 37.6 / 37.0 % (envelope not run); "paper" needs no patch Jacobian and takes
-    # fewer steps (median update 9.69 against 10.34 ms, 7.2 against 7.8 candidate models per frame on 150 frames
-    # of Car4, Bolt2, Woman, DragonBaby and David, interleaved runs).
+    # frame shifted by a known offset, descents from up to 3 px off end within 0.5 px of it in 73.6 % of the
+    # starts with "appearance", 17.4 % with "paper" or "envelope" (benchmarks/gradient_compare.py, 144 starts).
+    # In tracking they tie: 12 OTB sequences x 5 starts (the ground truth and 10 % off along the diagonals)
+    # 38.6 / 39.1 / 35.8 %, 4 more starts 10 % off along the axes 37.6 / 37.0 % (envelope not run); "paper" needs
+    # no patch Jacobian and takes fewer steps (median update 9.69 against 10.34 ms, 7.2 against 7.8 candidate
+    # models per frame on 150 frames of Car4, Bolt2, Woman, DragonBaby and David, interleaved runs).
     gradient: str = "appearance"
     # First descend from the prediction on the next pyramid level (a wider convergence region; see _search).  Off by
     # default since the translation filter's start: 12 OTB sequences x 5 starts 38.6 % without the coarse stage
@@ -73,7 +73,8 @@ class TrackerConfig:
     # the 4 diagonals (60 runs), with the defaults of the time (particles off, EMD scale variants, the backward
     # Lucas-Kanade pass seeded at the points): mean average overlap 34.1 % against 20.8 % without it.  The
     # figures that follow were measured with the particles on: 26.1 % against 22.2 % without (per start
-    # 30.5/27.0/24.0/23.7/25.5 vs 31.9/19.2/23.5/13.5/22.9 %).  Through the coarse stage too it scored 28.7 % (28.0 % with a 15x15 Lucas-Kanade window, 25.7 % at flow_max_error 2 px) but took the pooled
+    # 30.5/27.0/24.0/23.7/25.5 vs 31.9/19.2/23.5/13.5/22.9 %).  Through the coarse stage too it scored 28.7 %
+    # (28.0 % with a 15x15 Lucas-Kanade window, 25.7 % at flow_max_error 2 px) but took the pooled
     # median update of benchmarks/bench_speed.py from 8.3 to 10.2 ms.  As the only start (none at the
     # prediction) a prototype scored 27.0 % vs 35.4 % from the ground truth: the flow follows occluders too,
     # the EMD has to choose.  (Particles off: the flow start alone 30.2 %, through the coarse stage 31.4 %.)
@@ -339,8 +340,8 @@ class IemdTracker:
     def search_context(self, pyramid: ImagePyramid, angle: float = 0.0, coarse: bool = False) -> SearchContext:
         """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the current target model
         and dictionary, or (``coarse``) the coarse stage's: one pyramid level up, its own target, no sparse
-        coding (``coarse_to_fine`` only).  Also for analysis: ``CandidateModel(tracker.search_context(pyramid), centre, size).emd()``
-        scores any window against the target (benchmarks/model_ceiling.py, scale_curve.py)."""
+        coding (``coarse_to_fine`` only).  Also for analysis:
+        ``CandidateModel(tracker.search_context(pyramid), centre, size).emd()`` scores any window against the target (benchmarks/model_ceiling.py, scale_curve.py)."""
         if self._center is None:
             raise RuntimeError("IemdTracker.search_context() called before init()")
         cfg = self.config
