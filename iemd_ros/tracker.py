@@ -322,8 +322,8 @@ class IemdTracker:
         )
 
     def descend(self, frame: np.ndarray, box) -> TrackResult:
-        """Algorithm 1 alone on ``frame`` from the window ``box`` = (x, y, w, h), at that size, against the
-        current target model: no other starts, no translation filter, no scale search, and the tracker's state
+        """Algorithm 1 alone on ``frame`` from the axis-aligned window ``box`` = (x, y, w, h), at that size,
+        against the current target model: no other starts, no translation filter, no scale search, and the tracker's state
         (window, models, filters) is left as it is.  For analysis: the descent's capture range and the
         gradients compared (benchmarks/model_ceiling.py, gradient_compare.py)."""
         if self._center is None:
@@ -341,7 +341,8 @@ class IemdTracker:
         """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the current target model
         and dictionary, or (``coarse``) the coarse stage's: one pyramid level up, its own target, no sparse
         coding (``coarse_to_fine`` only).  Also for analysis:
-        ``CandidateModel(tracker.search_context(pyramid), centre, size).emd()`` scores any window against the target (benchmarks/model_ceiling.py, scale_curve.py)."""
+        ``CandidateModel(tracker.search_context(pyramid), centre, size).emd()`` scores any window against the
+        target (benchmarks/model_ceiling.py, scale_curve.py)."""
         if self._center is None:
             raise RuntimeError("IemdTracker.search_context() called before init()")
         cfg = self.config
