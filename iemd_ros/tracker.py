@@ -323,9 +323,9 @@ class IemdTracker:
 
     def descend(self, frame: np.ndarray, box) -> TrackResult:
         """Algorithm 1 alone on ``frame`` from the axis-aligned window ``box`` = (x, y, w, h), at that size,
-        against the current target model: no other starts, no translation filter, no scale search, and the tracker's state
-        (window, models, filters) is left as it is.  For analysis: the descent's capture range and the
-        gradients compared (benchmarks/model_ceiling.py, gradient_compare.py)."""
+        against the current target model: no other starts, no translation filter, no scale search, and the
+        tracker's state (window, models, filters) is left as it is.  For analysis: the descent's capture range
+        and the gradients compared (benchmarks/model_ceiling.py, gradient_compare.py)."""
         if self._center is None:
             raise RuntimeError("IemdTracker.descend() called before init()")
         _check_frame(frame)
