@@ -16,9 +16,10 @@ tracker (``TrackerConfig.translation_weight``) takes the displacement as one mor
 as evidence against the EMD when it chooses among the descended starts.
 
 Choices, measured over the 12 OTB sequences x 5 starts with every start descended (mean average overlap
-40.0 % with these defaults, 35.8 % without the filter): padding 1.5 (2.0: 38.1 %), learning rate 0.025 (0.05 / 0.012: 37.7 / 36.1 %),
-sigma_factor 0.1 (DSST's 1/16: 35.8 %, 0.2: 38.0 %), model area 4096 px (2048 / 8192: 40.2 / 37.1 %).
-With the defaults of 2026-11-23 (the default search scoring 38.6 %) learning rates 0.015 / 0.04 scored 35.0 / 36.3 %.
+40.0 % with these defaults, 35.8 % without the filter): padding 1.5 (2.0: 38.1 %), learning rate 0.025
+(0.05 / 0.012: 37.7 / 36.1 %), sigma_factor 0.1 (DSST's 1/16: 35.8 %, 0.2: 38.0 %), model area 4096 px
+(2048 / 8192: 40.2 / 37.1 %).  With the defaults of 2026-11-23 (the default search scoring 38.6 %) learning
+rates 0.015 / 0.04 scored 35.0 / 36.3 %.
 Estimate and update take about 1 ms per frame together.
 """
 from __future__ import annotations
