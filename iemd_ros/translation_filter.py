@@ -50,8 +50,7 @@ class TranslationFilter:
 
     def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
         """Learn the filter from the window (``center``, ``size``) of the first frame."""
-        self.model_size = model_size(np.asarray(size, dtype=np.float64) * (1.0 + self.padding), self.model_area,
-                                     min_cells=4)
+        self.model_size = model_size(self._region(size), self.model_area, min_cells=4)
         cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
         self._taper = np.outer(hann(rows), hann(cols))[..., None]
         sigma = self.sigma_factor * np.sqrt(cols * rows) / (1.0 + self.padding)
@@ -69,7 +68,7 @@ class TranslationFilter:
             raise RuntimeError("TranslationFilter.estimate() called before init()")
         response = np.fft.ifft2(self._filter.response(self._spectrum(pyramid, center, size, angle))).real
         rows, cols = response.shape
-        cell_px = np.asarray(size, dtype=np.float64) * (1.0 + self.padding) / [cols, rows]
+        cell_px = self._region(size) / [cols, rows]
         self._response = (response, np.asarray(center, dtype=np.float64), cell_px, angle)
         r, c = np.unravel_index(int(np.argmax(response)), response.shape)
         peak = response[r, c]
@@ -97,10 +96,13 @@ class TranslationFilter:
         """Blend in a sample at the tracked window (the running average of DSST eq. 5)."""
         self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
 
+    def _region(self, size) -> np.ndarray:
+        """(w, h) in image pixels of the search region around a window of ``size``: its size times 1 + ``padding``."""
+        return np.asarray(size, dtype=np.float64) * (1.0 + self.padding)
+
     def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
         """2-D FFT of the tapered (rows, cols, d) features of the search region around the window."""
-        region = np.asarray(size, dtype=np.float64) * (1.0 + self.padding)
-        sample = pyramid.sample(center, region, self.model_size, angle=angle)
+        sample = pyramid.sample(center, self._region(size), self.model_size, angle=angle)
         cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
         features = orientation_histograms(sample[None]).reshape(rows, cols, -1)
         return np.fft.fft2(features * self._taper, axes=(0, 1))
