@@ -1,0 +1,106 @@
+"""Staple's colour histograms: the per-pixel score beta, the window means, the start and the tracker's use."""
+import numpy as np
+import pytest
+
+from helpers import shifted, texture
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.colour_model import ColourModel
+
+RED, GREEN, BLUE = (0, 0, 255), (0, 255, 0), (255, 0, 0)  # BGR
+
+
+def _scene(shape=(120, 160), background=GREEN, target=RED, box=(60, 40, 21, 31)):
+    frame = np.empty((*shape, 3), np.uint8)
+    frame[:] = background
+    x, y, w, h = box
+    frame[y:y + h, x:x + w] = target
+    return frame
+
+
+def _centre(box):
+    x, y, w, h = box
+    return np.array([x + (w - 1) / 2.0, y + (h - 1) / 2.0])
+
+
+def test_beta_is_the_share_of_a_colour_on_the_target_and_windows_average_it():
+    """Target all red, surroundings all green: beta(red) = 1, beta(green) = 0, so a window's mean is the share of
+    it on red (hand-computed for the 21 x 31 px target: 1 on it, 16/21 5 px off, 1/2 half a width or height off,
+    between the positions 10 and 11 px off; 0 on bare background and outside the region); a colour neither has
+    scores 0.  (Odd sizes: the window's pixels then sit on image pixels, and nearest-neighbour sampling is exact.)"""
+    box = (60, 40, 21, 31)
+    model = ColourModel(model_area=10**6)  # no resampling: model pixels are image pixels
+    frame = _scene(box=box)
+    model.init(frame, _centre(box), box[2:])
+    assert np.allclose(model.estimate(frame, _centre(box), box[2:]), 0.0)
+    c = _centre(box)
+    assert model.score_at(c) == pytest.approx(1.0)
+    assert model.score_at(c + [10.5, 0.0]) == pytest.approx(0.5)
+    assert model.score_at(c + [0.0, 15.5]) == pytest.approx(0.5)
+    assert model.score_at(c + [5.0, 0.0]) == pytest.approx(16 / 21)
+    assert model.score_at(c + [30.0, 0.0]) == pytest.approx(0.0)
+    assert model.score_at(c + [500.0, 0.0]) == 0.0
+    blue = _scene(background=BLUE, target=BLUE, box=box)
+    model.estimate(blue, c, box[2:])
+    assert model.score_at(c) == 0.0
+
+
+def test_the_estimate_finds_the_moved_target_at_any_resampling_and_turn():
+    """The red target moved by (17, -9) px is found within a model pixel (half from nearest-neighbour sampling,
+    half from the window's size rounded to model pixels), with and
+    without resampling the region, and by a window turned by 90 degrees (its axes swap the target's width and
+    height)."""
+    box, move = (60, 40, 21, 31), np.array([17.0, -9.0])
+    moved = (box[0] + 17, box[1] - 9, *box[2:])
+    first, second = _scene(box=box), _scene(box=moved)
+    for model_area, angle, size in [(10**6, 0.0, box[2:]), (2048, 0.0, box[2:]), (10**6, np.pi / 2, box[:1:-1])]:
+        model = ColourModel(model_area=model_area)
+        model.init(first, _centre(box), size, angle)
+        estimate = model.estimate(second, _centre(box), size, angle)
+        region = 2.0 * np.asarray(size) + 2.0 * np.sqrt(21 * 31)
+        tolerance = 1.0 / min(1.0, np.sqrt(model_area / np.prod(region))) + 1e-9
+        assert np.allclose(estimate, move, atol=tolerance), (model_area, angle, estimate)
+        assert model.score_at(_centre(moved)) > 0.9
+
+
+def test_update_blends_the_histograms_at_the_learning_rate():
+    """After the target turns blue, one update at rate 0.25 gives beta(blue) = 0.25 / (0.25 + 0) = 1 and leaves
+    beta(red) = 0.75 / 0.75 = 1 (neither colour is in the surroundings); the green surroundings stay at 0."""
+    box = (60, 40, 21, 31)
+    model = ColourModel(learning_rate=0.25, model_area=10**6)
+    model.init(_scene(box=box), _centre(box), box[2:])
+    blue = _scene(target=BLUE, box=box)
+    model.update(blue, _centre(box), box[2:])
+    model.estimate(blue, _centre(box), box[2:])
+    assert model.score_at(_centre(box)) == pytest.approx(1.0)
+    assert model.score_at(_centre(box) + [10.5, 0.0]) == pytest.approx(0.5)
+
+
+def test_invalid_parameters_and_calls_raise():
+    for kwargs, message in [({"padding": -1.0}, "padding"), ({"learning_rate": 0.0}, "learning_rate"),
+                            ({"bins": 20}, "bins")]:
+        with pytest.raises(ValueError, match=message):
+            ColourModel(**kwargs)
+    with pytest.raises(RuntimeError, match="before init"):
+        ColourModel().estimate(_scene(), (70, 55), (20, 30))
+    with pytest.raises(RuntimeError, match="estimate"):
+        ColourModel().score_at((70, 55))
+    with pytest.raises(ValueError, match="colour_weight must be >= 0"):
+        TrackerConfig(colour_weight=-1.0)
+
+
+def test_the_tracker_uses_colour_on_colour_frames_only():
+    """A grey texture stored as BGR and a copy with the target tinted red, moved by 6 px: the colour model's peak
+    is one more start on the colour frames only; colour_weight 0 builds no model, and a grey frame in a colour
+    stream is tracked without it."""
+    grey = np.repeat(texture(seed=3)[..., None], 3, axis=2)
+    colour = grey.copy()
+    colour[40:80, 50:90, 2] = 255
+    box = (50, 40, 40, 40)
+    for first, second, weight, starts in [(grey, grey, 1.0, 1), (colour, colour, 1.0, 2), (colour, colour, 0.0, 1),
+                                          (colour, colour[..., 2], 1.0, 1)]:
+        tracker = IemdTracker(TrackerConfig(colour_weight=weight, flow_start=False, translation_weight=0.0))
+        tracker.init(first, box)
+        result = tracker.update(shifted(second, 6.0, 0.0))
+        assert result.starts == starts, (weight, second.ndim)
+        if starts == 2:
+            assert abs(result.box[0] - 56.0) < 1.0, result.box
