@@ -82,6 +82,8 @@ _TRACKER_DOC = {
     "flow_max_error": ("forward-backward error above which a flow point is dropped, px", (1e-3, 100.0)),
     "translation_weight": ("weight of the translation filter's response against EMD / background EMD when "
                            "choosing among the descended starts (0: no filter)", (0.0, 100.0)),
+    "colour_weight": ("weight of the colour histograms' mean score against EMD / background EMD, colour images "
+                      "only (0: no colour model)", (0.0, 100.0)),
     "descend_all_starts": ("with the translation filter, descend every start, not only the best by EMD and by score "
                            "(about 1.8x the update time)", None),
     "n_particles": ("extra starting points for abrupt motion (section 6.1)", (0, 64)),
