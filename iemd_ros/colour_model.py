@@ -21,10 +21,12 @@ more start and the mean at each window as evidence in its score; it uses the mod
 frames (a grey frame's histogram would repeat the grey levels the EMD already sees).
 
 Choices, measured over the 12 OTB sequences x 5 starts with colour_weight 0.75 (mean average overlap
-42.8 %, 38.6 % without the model): padding 1 (0.5 / 2: 40.5 / 41.7 %; at 2 Jogging-1/2 reach 51.4 / 41.6 %
-but Bolt2 and Woman fall to 13.4 / 18.3 %); Staple's learning rate 0.04 and 32 levels per channel; the
-whole window as the target's area (Staple shrinks it by a fifth of the mean side: not tried).  Estimate
-and update take about 0.4 ms each (Jogging-1, 640x480 frames cost the same: the region is resampled).
+42.8 %, 38.6 % without the model; 4 more starts along the axes 41.7 %, 37.6 % without): padding 1 (0.5 / 2:
+40.5 / 41.7 %; at 2 Jogging-1/2 reach 51.4 / 41.6 % but Bolt2 and Woman fall to 13.4 / 18.3 %); Staple's
+learning rate 0.04 (0.02 / 0.01: 43.2 / 42.9 % over the 5 starts but 39.5 / 41.2 % over the axis starts;
+0.08: 41.0 %); 32 levels per channel (16: 39.4 %); the whole window as the target's area (shrunk by a fifth
+of the mean side, as Staple does: 38.9 %).  Estimate and update take about 0.4 ms each (Jogging-1; a
+640x480 frame costs the same: the region is resampled).
 """
 from __future__ import annotations
 
