@@ -90,8 +90,9 @@ class TrackerConfig:
     # response there, when that is another one; the window of lower score is kept.  0: no filter.  12 OTB
     # sequences x 5 starts (as for flow_start), mean average overlap: 38.1 % against 35.8 % without (CSRT 41.8 %),
     # 8.2-9.6 candidate models per frame against 6.7-7.4 (Woman, Bolt2, David).  Weights 0.7 / 1.5 scored 39.0 /
-    # 37.2 %, within the spread of such runs.  Not updating the template and the two filters on frames whose
-    # response at the kept window is below 0.2 / 0.35 (against learning an occluder) scored 34.4 / 33.2 %.
+    # 37.2 %, within the spread of such runs; with the colour model 0.5 / 1.5 scored 41.4 / 41.1 % against 42.8 %.
+    # Not updating the template and the two filters on frames whose response at the kept window is below 0.2 / 0.35
+    # (against learning an occluder) scored 34.4 / 33.2 %.
     translation_weight: float = 1.0
     # Colour evidence (iemd_ros/colour_model.py, Staple's foreground/background colour histograms), on colour frames
     # only: the window of highest mean colour score is one more start, and colour_weight x that mean at a window is
