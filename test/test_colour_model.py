@@ -5,6 +5,8 @@ import pytest
 from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.colour_model import ColourModel
+from iemd_ros.metrics import iou
+from iemd_ros.otb import load_sequence, read_frame
 
 RED, GREEN, BLUE = (0, 0, 255), (0, 255, 0), (255, 0, 0)  # BGR
 
@@ -104,3 +106,16 @@ def test_the_tracker_uses_colour_on_colour_frames_only():
         assert result.starts == starts, (weight, second.ndim)
         if starts == 2:
             assert abs(result.box[0] - 56.0) < 1.0, result.box
+
+
+def test_tracks_a_real_colour_otb_excerpt(otb_root):
+    """Woman frames 1-100 (a colour sequence, so the colour model is on and its start is searched, a fourth
+    after the prediction, the flow and the translation filter): average overlap > 0.7 (0.78 measured; 0.76 with
+    colour_weight 0)."""
+    seq = load_sequence(otb_root / "Woman")
+    tracker = IemdTracker()
+    tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
+    results = [tracker.update(read_frame(path)) for path in seq.frame_paths[1:100]]
+    overlap = iou(np.array([seq.gt_boxes[0]] + [r.box for r in results]), seq.gt_boxes[:100])
+    assert max(r.starts for r in results) == 4
+    assert overlap.mean() > 0.7, overlap.mean()
