@@ -1,8 +1,10 @@
 """Colour evidence of the window's position: foreground and background colour histograms (Staple).
 
-Why the tracker needs it: the iEMD patches and both correlation filters see grey levels only.  Where a
-runner passes behind a post or a similar shape crosses the window, grey-level texture cannot tell them
-apart, and colour often can.  Staple (Bertinetto et al., "Staple: Complementary Learners for Real-Time
+Why the tracker needs it: the iEMD patches and both correlation filters see grey levels only, and a
+target often differs from its surroundings more in colour than in grey-level texture (over 12 OTB
+sequences x 5 starts the model lifted Bolt2 from 27.7 to 39.3 % and DragonBaby from 18.1 to 40.2 %).  It
+does not see through an occlusion: while the post hides Jogging-1's runner the window on the post scores a
+colour mean of 0.66-0.70, as high as on her (her tall box holds much background).  Staple (Bertinetto et al., "Staple: Complementary Learners for Real-Time
 Tracking", CVPR 2016, eq. 20-22) scores a window by the share of its pixels whose colour is more
 frequent on the target than around it: per colour bin b, with rho_O(b) and rho_B(b) the fractions of the
 target's and of the surrounding pixels in b, a pixel of bin b scores beta(b) = rho_O / (rho_O + rho_B)
@@ -25,8 +27,8 @@ Choices, measured over the 12 OTB sequences x 5 starts with colour_weight 0.75 (
 40.5 / 41.7 %; at 2 Jogging-1/2 reach 51.4 / 41.6 % but Bolt2 and Woman fall to 13.4 / 18.3 %); Staple's
 learning rate 0.04 (0.02 / 0.01: 43.2 / 42.9 % over the 5 starts but 39.5 / 41.2 % over the axis starts;
 0.08: 41.0 %); 32 levels per channel (16: 39.4 %); the whole window as the target's area (shrunk by a fifth
-of the mean side, as Staple does: 38.9 %).  Estimate and update take about 0.4 ms each (Jogging-1; a
-640x480 frame costs the same: the region is resampled).
+of the mean side, as Staple does: 38.9 %).  Estimate and update take about 0.4-0.5 ms each (Jogging-1,
+and a 64-px target on 640x480 frames: the region is resampled, so the cost hardly grows with the target).
 """
 from __future__ import annotations
 
@@ -50,8 +52,8 @@ class ColourModel:
             raise ValueError(f"padding must be >= 0, got {padding}")
         if not 0.0 < learning_rate <= 1.0:
             raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
-        if bins not in (2, 4, 8, 16, 32, 64, 128, 256):
-            raise ValueError(f"bins must be a power of 2 up to 256, got {bins}")
+        if bins not in (2, 4, 8, 16, 32, 64):  # bins**3 histogram entries: 64 -> 262144
+            raise ValueError(f"bins must be a power of 2 up to 64, got {bins}")
         self.padding = padding
         self.learning_rate = learning_rate
         self.bins = bins

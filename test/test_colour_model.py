@@ -79,7 +79,7 @@ def test_update_blends_the_histograms_at_the_learning_rate():
 
 def test_invalid_parameters_and_calls_raise():
     for kwargs, message in [({"padding": -1.0}, "padding"), ({"learning_rate": 0.0}, "learning_rate"),
-                            ({"bins": 20}, "bins")]:
+                            ({"bins": 20}, "bins"), ({"bins": 128}, "bins")]:
         with pytest.raises(ValueError, match=message):
             ColourModel(**kwargs)
     with pytest.raises(RuntimeError, match="before init"):
