@@ -28,7 +28,9 @@ Choices, measured over the 12 OTB sequences x 5 starts with colour_weight 0.75 (
 learning rate 0.04 (0.02 / 0.01: 43.2 / 42.9 % over the 5 starts but 39.5 / 41.2 % over the axis starts;
 0.08: 41.0 %); 32 levels per channel (16: 39.4 %); the whole window as the target's area (shrunk by a fifth
 of the mean side, as Staple does: 38.9 %; its pixels weighted by the Epanechnikov kernel of the
-paper's histograms: 41.1 %).  Estimate and update take about 0.4-0.5 ms each (Jogging-1,
+paper's histograms: 41.1 %); the colour peak as the start, not Staple's merged one (the peak of
+translation_weight x the filter's response + colour_weight x the colour mean over the colour map's
+windows, in place of the colour peak or besides it: 40.3 / 40.0 %).  Estimate and update take about 0.4-0.5 ms each (Jogging-1,
 and a 64-px target on 640x480 frames: the region is resampled, so the cost hardly grows with the target).
 """
 from __future__ import annotations
