@@ -43,6 +43,15 @@ def window_axes(angle: float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
+def warp_window(image: np.ndarray, centre, linear: np.ndarray, out_size, interpolation: int = cv2.INTER_LINEAR):
+    """The (Th, Tw) sample of ``image`` whose pixel u (0..T-1 per axis) is the image point
+    ``centre + linear @ (u - (T-1)/2)``, ``out_size`` = (Tw, Th); parts outside the image replicate its border."""
+    tw, th = (int(v) for v in out_size)
+    warp = np.column_stack([linear, np.asarray(centre, dtype=np.float64) - linear @ [(tw - 1) / 2, (th - 1) / 2]])
+    return cv2.warpAffine(image, warp, (tw, th), flags=interpolation | cv2.WARP_INVERSE_MAP,
+                          borderMode=cv2.BORDER_REPLICATE)
+
+
 class ImagePyramid:
     """Gaussian pyramid of one frame, so large windows are sampled without aliasing.
 
@@ -74,13 +83,8 @@ class ImagePyramid:
         axis points along (cos, sin) in the image.  Parts outside the image are
         padded by replicating the border.
         """
-        tw, th = template_size
         level, linear, centre = self._geometry(center, size, template_size, coarse, angle)
-        warp = np.column_stack([linear, centre - linear @ [(tw - 1) / 2, (th - 1) / 2]])
-        return cv2.warpAffine(
-            self.level(level), warp, (int(tw), int(th)),
-            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, borderMode=cv2.BORDER_REPLICATE,
-        )
+        return warp_window(self.level(level), centre, linear, template_size)
 
     def sample_scales(self, center, size, template_size, factors, angle: float = 0.0) -> np.ndarray:
         """The window scaled by each of ``factors`` about its centre, resampled to (Th, Tw) templates:
