@@ -4,6 +4,7 @@ import pytest
 
 from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.boxes import box_centre
 from iemd_ros.colour_model import ColourModel
 from iemd_ros.metrics import iou
 from iemd_ros.otb import load_sequence, read_frame
@@ -19,11 +20,6 @@ def _scene(shape=(120, 160), background=GREEN, target=RED, box=(60, 40, 21, 31))
     return frame
 
 
-def _centre(box):
-    x, y, w, h = box
-    return np.array([x + (w - 1) / 2.0, y + (h - 1) / 2.0])
-
-
 def test_beta_is_the_share_of_a_colour_on_the_target_and_windows_average_it():
     """Target all red, surroundings all green: beta(red) = 1, beta(green) = 0, so a window's mean is the share of
     it on red (hand-computed for the 21 x 31 px target: 1 on it, 16/21 5 px off, 1/2 half a width or height off,
@@ -32,9 +28,9 @@ def test_beta_is_the_share_of_a_colour_on_the_target_and_windows_average_it():
     box = (60, 40, 21, 31)
     model = ColourModel(model_area=10**6)  # no resampling: model pixels are image pixels
     frame = _scene(box=box)
-    model.init(frame, _centre(box), box[2:])
-    assert np.allclose(model.estimate(frame, _centre(box), box[2:]), 0.0)
-    c = _centre(box)
+    model.init(frame, box_centre(box), box[2:])
+    assert np.allclose(model.estimate(frame, box_centre(box), box[2:]), 0.0)
+    c = box_centre(box)
     assert model.score_at(c) == pytest.approx(1.0)
     assert model.score_at(c + [10.5, 0.0]) == pytest.approx(0.5)
     assert model.score_at(c + [0.0, 15.5]) == pytest.approx(0.5)
@@ -56,12 +52,12 @@ def test_the_estimate_finds_the_moved_target_at_any_resampling_and_turn():
     first, second = _scene(box=box), _scene(box=moved)
     for model_area, angle, size in [(10**6, 0.0, box[2:]), (2048, 0.0, box[2:]), (10**6, np.pi / 2, box[:1:-1])]:
         model = ColourModel(model_area=model_area)
-        model.init(first, _centre(box), size, angle)
-        estimate = model.estimate(second, _centre(box), size, angle)
+        model.init(first, box_centre(box), size, angle)
+        estimate = model.estimate(second, box_centre(box), size, angle)
         region = 2.0 * np.asarray(size) + 2.0 * np.sqrt(21 * 31)
         tolerance = 1.0 / min(1.0, np.sqrt(model_area / np.prod(region))) + 1e-9
         assert np.allclose(estimate, move, atol=tolerance), (model_area, angle, estimate)
-        assert model.score_at(_centre(moved)) > 0.9
+        assert model.score_at(box_centre(moved)) > 0.9
 
 
 def test_update_blends_the_histograms_at_the_learning_rate():
@@ -69,12 +65,12 @@ def test_update_blends_the_histograms_at_the_learning_rate():
     beta(red) = 0.75 / 0.75 = 1 (neither colour is in the surroundings); the green surroundings stay at 0."""
     box = (60, 40, 21, 31)
     model = ColourModel(learning_rate=0.25, model_area=10**6)
-    model.init(_scene(box=box), _centre(box), box[2:])
+    model.init(_scene(box=box), box_centre(box), box[2:])
     blue = _scene(target=BLUE, box=box)
-    model.update(blue, _centre(box), box[2:])
-    model.estimate(blue, _centre(box), box[2:])
-    assert model.score_at(_centre(box)) == pytest.approx(1.0)
-    assert model.score_at(_centre(box) + [10.5, 0.0]) == pytest.approx(0.5)
+    model.update(blue, box_centre(box), box[2:])
+    model.estimate(blue, box_centre(box), box[2:])
+    assert model.score_at(box_centre(box)) == pytest.approx(1.0)
+    assert model.score_at(box_centre(box) + [10.5, 0.0]) == pytest.approx(0.5)
 
 
 def test_invalid_parameters_and_calls_raise():
