@@ -468,7 +468,7 @@ class IemdTracker:
         models = [CandidateModel(fine, s, size) for s in (*ends, *fine_starts)]
         warnings += sum(_not_optimal(model.emd()[1]) for model in models)  # each model caches its EMD
         chosen = [min(models, key=lambda model: model.emd()[0])]
-        if self._translation_filter is not None or self._colour_now:
+        if self._discriminative:
             if self.config.descend_all_starts:
                 chosen = models
             else:
@@ -480,11 +480,16 @@ class IemdTracker:
         best.warnings = warnings + sum(state.warnings for state in descents)
         return best
 
+    @property
+    def _discriminative(self) -> bool:
+        """Whether this frame's score has terms besides the EMD: the translation filter's, the colour model's."""
+        return self._translation_filter is not None or self._colour_now
+
     def _score(self, emd: float, center) -> float:
         """What the search minimizes: the EMD, and with the translation filter or the colour model the EMD relative
         to the background EMD less ``translation_weight`` times the filter's response and ``colour_weight`` times
         the colour model's mean at the window centre ``center``."""
-        if self._translation_filter is None and not self._colour_now:
+        if not self._discriminative:
             return emd
         background = self._background_emd if np.isfinite(self._background_emd) else 1.0
         score = emd / background
