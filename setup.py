@@ -62,6 +62,7 @@ setup(
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
         (f"share/{PACKAGE}/config", glob("config/*")),
+        (f"share/{PACKAGE}/launch", glob("launch/*.launch.xml")),
         (f"lib/{PACKAGE}", ros_executables()),
     ],
     install_requires=["setuptools"],

@@ -52,6 +52,13 @@ def executable():
     return exe, params, env
 
 
+def test_launch_file_is_installed_in_the_share_folder(executable):
+    exe, params, _ = executable
+    installed = params.parents[1] / "launch" / "tracker.launch.xml"    # $(find-pkg-share iemd_ros)/launch
+    assert installed.is_file(), f"{installed} missing: `ros2 launch iemd_ros tracker.launch.xml` would not find it"
+    assert installed.read_text() == (Path(__file__).resolve().parents[1] / "launch" / "tracker.launch.xml").read_text()
+
+
 def _start(exe, args, env):
     return subprocess.Popen([str(exe), *args], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
