@@ -84,6 +84,8 @@ _TRACKER_DOC = {
                            "choosing among the descended starts (0: no filter)", (0.0, 100.0)),
     "colour_weight": ("weight of the colour histograms' mean score against EMD / background EMD, colour images "
                       "only (0: no colour model)", (0.0, 100.0)),
+    "motion_weight": ("weight of the squared displacement from the prediction, over the window's area, in the "
+                      "same score (0: no motion prior)", (0.0, 100.0)),
     "descend_all_starts": ("with the translation filter, descend every start, not only the best by EMD and by score "
                            "(about 1.8x the update time)", None),
     "n_particles": ("extra starting points for abrupt motion (section 6.1)", (0, 64)),
