@@ -1,14 +1,16 @@
 #!/usr/bin/env python3
 """Robustness to the initial box: average overlap from shifted starts, iEMD against CSRT in the same run.
 
-    python benchmarks/perturbed_starts.py [--sequences Car4,Bolt2] [--shift 0.1] \
+    python benchmarks/perturbed_starts.py [--sequences Car4,Bolt2] [--shift 0.1] [--starts sre] \
         [--config "{}" --config "{'alpha': 0.4}"] [--jobs 2]
 
 OTB's one-pass evaluation starts every tracker from the exact ground truth, and a single run of a
 tracker whose result swings with small changes says little.  As OTB's spatial robustness evaluation
 (SRE) does, every sequence is also started from the ground truth shifted by ``shift`` of its size
-along the four diagonals (5 starts in all); each run is scored over all its frames against the
-ground truth (iemd_ros.metrics).  Printed per tracker: the mean average overlap over sequences and
+along the four diagonals (5 starts in all); with ``--starts sre`` also along the four axes and with
+the box scaled by 0.8, 0.9, 1.1 and 1.2 about its centre (13 starts: OTB's 8 spatial shifts and 4 scale
+variations, and the ground truth).  Each run is scored over all its frames against the ground truth
+(iemd_ros.metrics).  Printed per tracker: the mean average overlap over sequences and
 starts, its mean per start, per sequence, and the median update time.  ``--config`` runs iEMD with
 other TrackerConfig values (default: the defaults), each against the same peers.
 """
@@ -25,20 +27,32 @@ from iemd_ros.evaluation import make_tracker, run_tracker, sequence_names
 from iemd_ros.metrics import score_sequence
 from iemd_ros.otb import default_root, load_sequence
 
-DIAGONALS = ((0.0, 0.0), (1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0))
+# Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, and the box's scale.
+DIAGONALS = ((0.0, 0.0, 1.0), (1.0, 1.0, 1.0), (-1.0, 1.0, 1.0), (1.0, -1.0, 1.0), (-1.0, -1.0, 1.0))
+AXES = ((1.0, 0.0, 1.0), (-1.0, 0.0, 1.0), (0.0, 1.0, 1.0), (0.0, -1.0, 1.0))
+SCALES = tuple((0.0, 0.0, s) for s in (0.8, 0.9, 1.1, 1.2))
+START_SETS = {"diagonal": DIAGONALS, "sre": DIAGONALS + AXES + SCALES}
+
+
+def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: float) -> np.ndarray:
+    """The box (x, y, w, h) ``first`` with its centre moved by (dx, dy) x ``shift`` x its size, then scaled by
+    ``scale`` about that centre."""
+    centre = first[:2] + first[2:] / 2.0 + np.array([dx, dy]) * shift * first[2:]
+    size = first[2:] * scale
+    return np.concatenate([centre - size / 2.0, size])
 
 
 def run(job):
     """[(average overlap, median update ms) per start] of each run on one sequence, decoded once."""
-    name, runs, shift = job
+    name, runs, shift, starts = job
     seq = load_sequence(name, default_root())
     frames = list(seq.frames())
     first = np.asarray(seq.gt_boxes[0], dtype=float)
     out = []
     for label, tracker_name, config in runs:
         rows = []
-        for direction in DIAGONALS:
-            start = first + np.array([direction[0] * shift * first[2], direction[1] * shift * first[3], 0.0, 0.0])
+        for dx, dy, scale in starts:
+            start = start_box(first, dx, dy, scale, shift)
             tracker = make_tracker(tracker_name, config)
             result = run_tracker(tracker, frames, start)
             scores = score_sequence(result.boxes, seq.gt_boxes, name)
@@ -53,6 +67,8 @@ def main() -> None:
     parser.add_argument("--peers", default="csrt", help="comma-separated OpenCV peers (default: csrt)")
     parser.add_argument("--config", action="append", help="iEMD TrackerConfig values as a Python dict (repeatable)")
     parser.add_argument("--shift", type=float, default=0.1, help="start shift, fraction of the box size")
+    parser.add_argument("--starts", choices=sorted(START_SETS), default="diagonal",
+                        help="diagonal: the ground truth and 4 diagonal shifts; sre: also 4 axis shifts, 4 scales")
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     names = sequence_names(args.sequences)
@@ -64,12 +80,14 @@ def main() -> None:
         make_tracker(peer)
     runs += [(peer, peer, None) for peer in peers]
     with Pool(args.jobs) as pool:
-        results = pool.map(run, [(name, runs, args.shift) for name in names], chunksize=1)
-    print(f"{len(names)} sequences x {len(DIAGONALS)} starts (ground truth, and shifted by {args.shift:g} of its "
-          "size along the diagonals)")
+        results = pool.map(run, [(name, runs, args.shift, START_SETS[args.starts]) for name in names], chunksize=1)
+    n_starts = len(START_SETS[args.starts])
+    which = "the diagonals" if args.starts == "diagonal" else "the diagonals and the axes, and scaled by 0.8-1.2"
+    print(f"{len(names)} sequences x {n_starts} starts (ground truth, and shifted by {args.shift:g} of its size "
+          f"along {which})")
     for i, (label, _, _) in enumerate(runs):
         rows = [row for per_sequence in results for row in per_sequence[i]]
-        overlap = np.array([ao for ao, _ in rows]).reshape(len(names), len(DIAGONALS)) * 100
+        overlap = np.array([ao for ao, _ in rows]).reshape(len(names), n_starts) * 100
         speed = np.median([ms for _, ms in rows])
         starts = " ".join(f"{v:4.1f}" for v in overlap.mean(axis=0))
         print(f"{label:60s} mean AO {overlap.mean():5.1f} %  per start {starts}  median update {speed:.1f} ms")
