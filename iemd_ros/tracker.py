@@ -114,9 +114,8 @@ class TrackerConfig:
     # 39.9 % against 36.0 % (benchmarks/perturbed_starts.py --starts sre runs all 13).  Weights 0.025 / 0.1 scored
     # 43.5 / 41.6 % over the 5 starts and 42.5 / 43.4 % over the axis starts; the displacement in window sizes per
     # axis instead of sqrt(w h) (tall windows then pay more for a sideways move) scored 41.9 / 41.4 % at 0.05 / 0.1
-    # over the 5 starts.  Jogging-1 gains most (15.2 to 37.5 % over the 5 starts), Woman
-    # loses (55.5 to 49.8 %: when a car hides her legs, about frame 120, far starts are also what brought the window
-    # back).
+    # over the 5 starts.  Jogging-1 gains most (15.2 to 37.5 % over the 5 starts), Woman loses (55.5 to 49.8 %: when
+    # a car hides her legs, about frame 120, far starts are also what brought the window back).
     motion_weight: float = 0.05
     # Descend every start and keep the window of lowest score: 40.0 % over the same 60 runs, at 14.2-18.8 models
     # per frame (about 1.8x the update time).  With it, weights 0.5 / 2 scored 37.4 / 35.7 %, keeping the lowest
@@ -448,7 +447,8 @@ class IemdTracker:
         ``fine_starts`` skip the coarse stage: the flow start, which pyramidal Lucas-Kanade already
         placed coarse to fine, the translation filter's and the colour model's.  The start of lowest EMD is
         refined, and with the translation filter or the colour model also the start of lowest :meth:`_score` (or
-        every start: ``descend_all_starts``); the refined window of lowest score is kept.
+        every start: ``descend_all_starts``); the refined window of lowest score is kept.  ``prediction`` is the
+        predicted centre, from which the score's motion prior measures a window's displacement.
 
         The appearance EMD is minimal at the target, but its basin is only about
         as wide as the patches' texture is coarse (a few pixels for fine texture).
