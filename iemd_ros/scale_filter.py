@@ -86,12 +86,16 @@ class ScaleFilter:
         self._last = (spectrum, shift)
         return float(self.step**shift)
 
-    def update(self) -> None:
+    def update(self, scale: float | None = None) -> None:
         """Blend the last estimate's sample in (the running average of DSST eq. 5), its desired response
-        peaked at the scale it estimated."""
+        peaked at the scale it estimated, or at ``scale`` relative to its window when the tracker took another
+        (its bounds on the window's size)."""
         if self._last is None:
             raise RuntimeError("ScaleFilter.update() needs an estimate() first")
-        self._learn(*self._last)
+        spectrum, shift = self._last
+        if scale is not None:
+            shift = float(np.log(scale) / np.log(self.step))
+        self._learn(spectrum, shift)
         self._last = None
 
     # ------------------------------------------------------------ internals

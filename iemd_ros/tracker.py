@@ -186,6 +186,7 @@ class TrackerConfig:
 
 
 _COARSE_LEVELS = 1  # pyramid levels above the fine one at which the coarse stage samples
+MIN_SIDE_PX = 4.0  # the scale search never shrinks a window's shorter side below this (image pixels)
 
 
 @dataclass
@@ -337,6 +338,8 @@ class IemdTracker:
             final = _Descent(model=best.model, emd=best.emd)
         else:
             final, scale = self._search_scale(best)
+        estimated = scale
+        scale = _bounded_scale(scale, best.model.size, frame.shape)
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
         best_box = _box(new_center, new_size, angle)
         reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
@@ -344,7 +347,7 @@ class IemdTracker:
         if not lost:
             self._center, self._size, self._angle = new_center, new_size, angle
             if self._scale_filter is not None:
-                self._scale_filter.update()
+                self._scale_filter.update(scale if scale != estimated else None)
             if self._translation_filter is not None:
                 self._translation_filter.update(pyramid, new_center, new_size, angle)
             if self._colour_now:
@@ -605,6 +608,17 @@ def _box(center, size, angle: float = 0.0):
     c, s = abs(np.cos(angle)), abs(np.sin(angle))
     w, h = c * size[0] + s * size[1], s * size[0] + c * size[1]
     return tuple(float(v) for v in centre_box(center, (w, h)))
+
+
+def _bounded_scale(scale: float, size, shape) -> float:
+    """``scale`` limited so that the window of ``size`` (w, h) keeps its shorter side at least MIN_SIDE_PX and its
+    area at most the image's (``shape``): DSST's bounds on the scale factor, by area so that they hold for a turned
+    window too.  A window already outside them may not move further out.  Without the upper bound a window started
+    20 % too large on Car4 grew to more than the image's area by frame 195 (the scale filter learns the background
+    in it as target), and 11x the target's by mid-sequence."""
+    lower = MIN_SIDE_PX / float(min(size))
+    upper = float(np.sqrt(shape[0] * shape[1] / (size[0] * size[1])))
+    return float(np.clip(scale, min(lower, 1.0), max(upper, 1.0)))
 
 
 def _not_optimal(solution) -> int:

@@ -49,6 +49,20 @@ def test_update_learns_at_the_estimated_scale(car4_first):
         scale_filter.update()
 
 
+def test_update_learns_at_the_scale_the_tracker_took(car4_first):
+    """update(scale) centres the desired response on ``scale`` instead of the estimate (the tracker's bounds on
+    the window): told that the 6 % larger target is at scale 1, the filter measures it at scale 1 from the
+    original window's size."""
+    frame, box = car4_first
+    pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(box), box[2:]
+    scale_filter = ScaleFilter(learning_rate=1.0)
+    scale_filter.init(pyramid, centre, size)
+    bigger = ImagePyramid(to_gray(zoomed(frame, centre, 1.06)))
+    assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.06, rel=0.015)
+    scale_filter.update(1.0)
+    assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.0, abs=0.01)
+
+
 def test_invalid_use_is_refused():
     with pytest.raises(RuntimeError, match="before init"):
         ScaleFilter().estimate(ImagePyramid(np.zeros((64, 64), np.float32)), (32, 32), (16, 16))

@@ -11,7 +11,7 @@ from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
 from iemd_ros.otb import load_sequence, read_frame
 from iemd_ros.template import TemplateDictionary
-from iemd_ros.tracker import _visible_fraction
+from iemd_ros.tracker import MIN_SIDE_PX, _bounded_scale, _visible_fraction
 
 
 @pytest.mark.parametrize("bad,match", [
@@ -272,3 +272,29 @@ def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
     assert TrackerConfig().motion_weight > 0
     assert offsets[0.0][1] > 0.8, offsets
     assert offsets[TrackerConfig().motion_weight].max() < 0.3, offsets
+
+
+def test_scale_bounds_keep_the_window_between_a_few_pixels_and_the_image():
+    shape = (240, 360)
+    assert _bounded_scale(1.05, (100.0, 80.0), shape) == 1.05                      # inside: untouched
+    assert _bounded_scale(0.5, (6.0, 40.0), shape) == MIN_SIDE_PX / 6.0            # shorter side kept at 4 px
+    assert np.isclose(_bounded_scale(2.0, (300.0, 200.0), shape) ** 2 * 300 * 200, 240 * 360)  # area <= image
+    assert _bounded_scale(1.1, (400.0, 300.0), shape) == 1.0                       # already larger: no further
+    assert _bounded_scale(0.9, (400.0, 300.0), shape) == 0.9                       # ... but it may shrink
+
+
+def test_a_window_started_too_large_never_outgrows_the_image(otb_root):
+    """Car4 from its first box scaled by 1.2 about the centre: the scale filter learns the road in the window as
+    target and the window grows; without the bound its area exceeded the image's by frame 195 (measured)."""
+    seq = load_sequence(otb_root / "Car4")
+    x, y, w, h = seq.gt_boxes[0]
+    frames = [read_frame(path) for path in seq.frame_paths[:230]]
+    height, width = frames[0].shape[:2]
+    tracker = IemdTracker()
+    tracker.init(frames[0], (x - 0.1 * w, y - 0.1 * h, 1.2 * w, 1.2 * h))
+    areas = []
+    for frame in frames[1:]:
+        box = tracker.update(frame).box
+        areas.append(box[2] * box[3])
+    assert max(areas) > 0.9 * width * height      # it does grow to the bound
+    assert max(areas) <= width * height * (1 + 1e-9)
