@@ -72,9 +72,10 @@ class ScaleFilter:
         self._learn(self._spectrum(pyramid, center, size, angle), 0.0)
         self._last = None
 
-    def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> float:
+    def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0, bounds=None) -> float:
         """Relative scale of the target in ``pyramid``'s frame against the window ``size`` at ``center``: the
-        factor where the filter response peaks, refined between scales by a parabola through the peak."""
+        factor where the filter response peaks, refined between scales by a parabola through the peak, and
+        limited to ``bounds`` (lowest, highest) if given.  ``update`` learns at the scale returned."""
         if not self._filter.trained:
             raise RuntimeError("ScaleFilter.estimate() called before init()")
         spectrum = self._spectrum(pyramid, center, size, angle)
@@ -83,19 +84,17 @@ class ScaleFilter:
         shift = peak - len(response) // 2
         if 0 < peak < len(response) - 1:
             shift += parabola_peak(*response[peak - 1:peak + 2])
+        if bounds is not None:
+            shift = float(np.clip(shift, *(np.log(bounds) / np.log(self.step))))
         self._last = (spectrum, shift)
         return float(self.step**shift)
 
-    def update(self, scale: float | None = None) -> None:
+    def update(self) -> None:
         """Blend the last estimate's sample in (the running average of DSST eq. 5), its desired response
-        peaked at the scale it estimated, or at ``scale`` relative to its window when the tracker took another
-        (its bounds on the window's size)."""
+        peaked at the scale it estimated."""
         if self._last is None:
             raise RuntimeError("ScaleFilter.update() needs an estimate() first")
-        spectrum, shift = self._last
-        if scale is not None:
-            shift = float(np.log(scale) / np.log(self.step))
-        self._learn(spectrum, shift)
+        self._learn(*self._last)
         self._last = None
 
     # ------------------------------------------------------------ internals

@@ -328,18 +328,17 @@ class IemdTracker:
             searches.append(candidate)
             if candidate.emd < best.emd:
                 best = candidate
+        bounds = _scale_bounds(best.model.size, frame.shape)
         if self._scale_filter is not None:
             # The scale filter's estimate at the converged centre.  The window is not coded and solved again at the
             # new size: the EMD barely sees scale (scale_filter.py), and the template Algorithm 2 learns is resampled
             # to the template size anyway.  Solving it there changed nothing over 12 OTB sequences x 5 starts (38.6 %
             # mean average overlap either way) and cost 0.5-0.8 ms per frame (one candidate model); with the true
             # centre set before each frame (benchmarks/scale_curve.py) the size error is 13.1 % against 12.3 %.
-            scale = self._scale_filter.estimate(pyramid, best.center, best.model.size, best.model.angle)
+            scale = self._scale_filter.estimate(pyramid, best.center, best.model.size, best.model.angle, bounds)
             final = _Descent(model=best.model, emd=best.emd)
         else:
-            final, scale = self._search_scale(best)
-        estimated = scale
-        scale = _bounded_scale(scale, best.model.size, frame.shape)
+            final, scale = self._search_scale(best, bounds)
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
         best_box = _box(new_center, new_size, angle)
         reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
@@ -347,7 +346,7 @@ class IemdTracker:
         if not lost:
             self._center, self._size, self._angle = new_center, new_size, angle
             if self._scale_filter is not None:
-                self._scale_filter.update(scale if scale != estimated else None)
+                self._scale_filter.update()
             if self._translation_filter is not None:
                 self._translation_filter.update(pyramid, new_center, new_size, angle)
             if self._colour_now:
@@ -554,7 +553,7 @@ class IemdTracker:
                 step *= 0.5
         return state
 
-    def _search_scale(self, state: _Descent) -> tuple[_Descent, float]:
+    def _search_scale(self, state: _Descent, bounds: tuple[float, float]) -> tuple[_Descent, float]:
         """Scale variants at the converged centre (paper: window enlarged/shrunk by 2%).
 
         Each variant is a candidate model of the window resampled at s * size, so it
@@ -566,7 +565,7 @@ class IemdTracker:
         (the paper's gyro experiment searches +-10 %: a camera closing in on the
         target grows it faster than 2 % per frame).  Taking a variant only when it lowers the EMD by
         more than 1 % (against size drift from noise) was measured at 31.0 % against 31.9 %, 12 OTB
-        sequences.  Returns the chosen window (its
+        sequences.  No variant leaves ``bounds`` (:func:`_scale_bounds`).  Returns the chosen window (its
         ``codings`` and ``warnings`` those of the variants) and its relative scale.
         """
         cfg = self.config
@@ -578,6 +577,8 @@ class IemdTracker:
         for direction in (-1.0, 1.0):
             for n in range(1, n_steps + 1):
                 scale = 1.0 + direction * n * cfg.scale_step
+                if not bounds[0] <= scale <= bounds[1]:
+                    break
                 model = state.model.at(state.center, state.model.size * scale)
                 emd, sol = model.emd()
                 chosen.codings += 1
@@ -610,15 +611,15 @@ def _box(center, size, angle: float = 0.0):
     return tuple(float(v) for v in centre_box(center, (w, h)))
 
 
-def _bounded_scale(scale: float, size, shape) -> float:
-    """``scale`` limited so that the window of ``size`` (w, h) keeps its shorter side at least MIN_SIDE_PX and its
-    area at most the image's (``shape``): DSST's bounds on the scale factor, by area so that they hold for a turned
-    window too.  A window already outside them may not move further out.  Without the upper bound a window started
-    20 % too large on Car4 grew to more than the image's area by frame 195 (the scale filter learns the background
-    in it as target), and 11x the target's by mid-sequence."""
+def _scale_bounds(size, shape) -> tuple[float, float]:
+    """(lowest, highest) relative scale of the window of ``size`` (w, h): its shorter side stays at least
+    MIN_SIDE_PX and its area at most the image's (``shape``), DSST's bounds on the scale factor, by area so that
+    they hold for a turned window too.  A window already outside them may not move further out.  Without the upper
+    bound a window started 20 % too large on Car4 grew to more than the image's area by frame 195 (the scale filter
+    learns the background in it as target), and 11x the target's by mid-sequence."""
     lower = MIN_SIDE_PX / float(min(size))
     upper = float(np.sqrt(shape[0] * shape[1] / (size[0] * size[1])))
-    return float(np.clip(scale, min(lower, 1.0), max(upper, 1.0)))
+    return min(lower, 1.0), max(upper, 1.0)
 
 
 def _not_optimal(solution) -> int:

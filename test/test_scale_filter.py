@@ -50,16 +50,17 @@ def test_update_learns_at_the_estimated_scale(car4_first):
 
 
 def test_update_learns_at_the_scale_the_tracker_took(car4_first):
-    """update(scale) centres the desired response on ``scale`` instead of the estimate (the tracker's bounds on
-    the window): told that the 6 % larger target is at scale 1, the filter measures it at scale 1 from the
-    original window's size."""
+    """An estimate limited by ``bounds`` (the tracker's bounds on the window) is what update() learns: told that
+    the 6 % larger target may be at most at scale 1, the filter then measures it at scale 1 from the original
+    window's size."""
     frame, box = car4_first
     pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(box), box[2:]
     scale_filter = ScaleFilter(learning_rate=1.0)
     scale_filter.init(pyramid, centre, size)
     bigger = ImagePyramid(to_gray(zoomed(frame, centre, 1.06)))
     assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.06, rel=0.015)
-    scale_filter.update(1.0)
+    assert scale_filter.estimate(bigger, centre, size, bounds=(0.5, 1.0)) == pytest.approx(1.0, abs=1e-12)
+    scale_filter.update()
     assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.0, abs=0.01)
 
 

@@ -11,7 +11,7 @@ from iemd_ros.boxes import box_centre
 from iemd_ros.metrics import iou
 from iemd_ros.otb import load_sequence, read_frame
 from iemd_ros.template import TemplateDictionary
-from iemd_ros.tracker import MIN_SIDE_PX, _bounded_scale, _visible_fraction
+from iemd_ros.tracker import MIN_SIDE_PX, _scale_bounds, _visible_fraction
 
 
 @pytest.mark.parametrize("bad,match", [
@@ -276,6 +276,10 @@ def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
 
 def test_scale_bounds_keep_the_window_between_a_few_pixels_and_the_image():
     shape = (240, 360)
+
+    def _bounded_scale(scale, size, shape):
+        return float(np.clip(scale, *_scale_bounds(size, shape)))
+
     assert _bounded_scale(1.05, (100.0, 80.0), shape) == 1.05                      # inside: untouched
     assert _bounded_scale(0.5, (6.0, 40.0), shape) == MIN_SIDE_PX / 6.0            # shorter side kept at 4 px
     assert np.isclose(_bounded_scale(2.0, (300.0, 200.0), shape) ** 2 * 300 * 200, 240 * 360)  # area <= image
