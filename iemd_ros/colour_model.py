@@ -93,8 +93,8 @@ class ColourModel:
             raise RuntimeError("ColourModel.estimate() called before init()")
         size = np.asarray(size, dtype=np.float64)
         region = 2.0 * size + 2.0 * self.padding * np.sqrt(size[0] * size[1])
-        scale = min(1.0, np.sqrt(self.model_area / (region[0] * region[1])))
-        beta = self._beta[self._bin_indices(frame, center, region, angle, scale)]
+        bins, scale = self._bin_indices(frame, center, region, angle)
+        beta = self._beta[bins]
         integral = cv2.integral(beta, sdepth=cv2.CV_64F)
         ww, wh = (max(1, int(round(v))) for v in size * scale)
         sums = integral[wh:, ww:] - integral[:-wh, ww:] - integral[wh:, :-ww] + integral[:-wh, :-ww]
@@ -127,9 +127,7 @@ class ColourModel:
         """rho_O and rho_B: the colour-bin fractions of the window and of its surroundings (the window grown by
         half its mean side, less the window)."""
         size = np.asarray(size, dtype=np.float64)
-        area = size + 0.5 * (size[0] + size[1])
-        scale = min(1.0, np.sqrt(self.model_area / (area[0] * area[1])))
-        bins = self._bin_indices(frame, center, area, angle, scale)
+        bins, scale = self._bin_indices(frame, center, size + 0.5 * (size[0] + size[1]), angle)
         h, w = bins.shape
         ys, xs = np.abs(np.arange(h) - (h - 1) / 2.0), np.abs(np.arange(w) - (w - 1) / 2.0)
         half = size * scale / 2.0
@@ -139,13 +137,14 @@ class ColourModel:
         surroundings = np.bincount(bins[~inside], minlength=n).astype(np.float64)
         return target / max(target.sum(), 1.0), surroundings / max(surroundings.sum(), 1.0)
 
-    def _bin_indices(self, frame, center, region, angle, scale) -> np.ndarray:
-        """The region (w, h) around ``center`` in the axes of a window turned by ``angle``, resampled by
-        ``scale`` (nearest neighbour), as colour-bin indices."""
+    def _bin_indices(self, frame, center, region, angle) -> tuple[np.ndarray, float]:
+        """The region (w, h) around ``center`` in the axes of a window turned by ``angle``, resampled (nearest
+        neighbour) to at most ``model_area`` pixels, as colour-bin indices; and the scale (model px per image px)."""
+        scale = min(1.0, np.sqrt(self.model_area / (region[0] * region[1])))
         out_size = [max(1, int(round(v * scale))) for v in region]
         sample = warp_window(frame, center, window_axes(angle) / scale, out_size, cv2.INTER_NEAREST)
         q = (sample >> self._shift).astype(np.intp)
-        return (q[..., 0] * self.bins + q[..., 1]) * self.bins + q[..., 2]
+        return (q[..., 0] * self.bins + q[..., 1]) * self.bins + q[..., 2], scale
 
 
 def _beta(target: np.ndarray, surroundings: np.ndarray) -> np.ndarray:
