@@ -86,6 +86,9 @@ _TRACKER_DOC = {
                       "only (0: no colour model)", (0.0, 100.0)),
     "motion_weight": ("weight of the squared displacement from the prediction, over the window's area, in the "
                       "same score (0: no motion prior)", (0.0, 100.0)),
+    "update_confidence": ("a tracked frame learns (template, filters, colour, size) only when the translation "
+                          "filter's response at the window is at least this times its running mean (0: always)",
+                          (0.0, 0.99)),
     "descend_all_starts": ("with the translation filter, descend every start, not only the best by EMD and by score "
                            "(about 1.8x the update time)", None),
     "n_particles": ("extra starting points for abrupt motion (section 6.1)", (0, 64)),

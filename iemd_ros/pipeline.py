@@ -312,7 +312,7 @@ class TrackingPipeline:
         self._last_stamp: int | None = None
         self._lost_run = 0
         self.counters = dict(frames_received=0, frames_processed=0, frames_uninitialized=0, frames_dropped=0,
-                             frames_rejected=0, images_malformed=0, frames_lost=0, gyro_used=0, gyro_unused=0,
+                             frames_rejected=0, images_malformed=0, frames_lost=0, frames_held=0, gyro_used=0, gyro_unused=0,
                              imu_received=0, imu_rejected=0, imu_out_of_order=0, imu_saturated=0,
                              clock_resets=0, camera_infos=0, camera_infos_rejected=0, inits=0, resets=0)
         self._last = dict(frame_reason="", gyro_reason="", imu_reason="", image_error="", camera_error="",
@@ -588,6 +588,7 @@ class TrackingPipeline:
         else:
             self._lost_run = 0
             self._state = "tracking"
+            c["frames_held"] += bool(result.held)
             self._ref = (t, box, frame)
         emd = float(result.emd)
         score = math.exp(-emd / self._cfg.score_emd_scale) if not result.lost and math.isfinite(emd) else 0.0
@@ -655,7 +656,7 @@ class TrackingPipeline:
         else:
             trk = (OK, f"tracking (EMD {d['emd']:.4f}, {d['iterations']} iterations)")
         tracking = Status(f"{prefix}: tracking", *trk,
-                          vals("state", "emd", "iterations", "lost_run", "frames_lost", "processing_ms_mean",
+                          vals("state", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
                                "processing_ms_max", "processing_rate_hz", "inits", "resets", "frame_reason"))
         # image input
         if d["image_bad"]:

@@ -9,7 +9,7 @@ from iemd_ros.camera import CameraModel
 from iemd_ros.gyro import GyroConfig, GyroPredictor
 from iemd_ros.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
 from iemd_ros.synthetic import generate
-from iemd_ros.tracker import TrackerConfig
+from iemd_ros.tracker import IemdTracker, TrackerConfig
 
 N = 24
 
@@ -248,6 +248,21 @@ def test_input_problem_statuses(seq):
     assert st[1].level == WARN and "falls behind" in st[1].message
     assert p.diagnostics()["frames_dropped"] == 4 and p.diagnostics()["images_malformed"] == 1
     assert st[2].level == WARN and "no IMU" in st[2].message
+
+
+def test_held_frames_are_tracked_counted_and_explained(seq, monkeypatch):
+    """A frame the tracker holds (its occlusion check: the models do not learn) is still a tracked frame; it is
+    counted in ``frames_held`` and its reason reaches ``frame_reason`` and the tracking status's values."""
+    p, stamps = _started(seq)
+    p.process(seq.frames[1], stamps[1])
+    assert p.diagnostics()["frames_held"] == 0
+    monkeypatch.setattr(IemdTracker, "_confidence_check",
+                        lambda self, center: (0.01, "models not updated: filter response 0.010 < 0.6 x ..."))
+    results = [p.process(seq.frames[k], stamps[k]) for k in (2, 3)]
+    assert all(r.state == "tracking" and r.reason.startswith("models not updated") for r in results)
+    d = p.diagnostics()
+    assert d["frames_held"] == 2 and d["frames_lost"] == 0 and d["frame_reason"].startswith("models not updated")
+    assert p.statuses()[0].level == OK and p.statuses()[0].values["frames_held"] == "2"
 
 
 def test_frame_result_defaults():

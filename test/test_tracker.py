@@ -54,7 +54,8 @@ def test_invalid_prior_and_call_order():
 
 def test_invalid_config_is_rejected():
     for kwargs in [dict(alpha=1.5), dict(lam=0), dict(gradient="newton"), dict(patch_size=(40, 40)),
-                   dict(scale_step=0.7), dict(motion_weight=-0.1)]:
+                   dict(scale_step=0.7), dict(motion_weight=-0.1), dict(update_confidence=1.0),
+                   dict(update_confidence=-0.1)]:
         with pytest.raises(ValueError):
             TrackerConfig(**kwargs)
     with pytest.raises(ValueError, match="unknown tracker parameters: bogus"):
@@ -272,6 +273,40 @@ def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
     assert TrackerConfig().motion_weight > 0
     assert offsets[0.0][1] > 0.8, offsets
     assert offsets[TrackerConfig().motion_weight].max() < 0.3, offsets
+
+
+def test_occlusion_check_holds_the_models_while_a_post_hides_the_runner(otb_root):
+    """Jogging-2 frames 1-75.  Over frames 45-60 the runner passes behind a post.  Learning on every frame, the
+    scale filter widens the window over the post while every model learns it, and by frame 75 the window has
+    gone with the post (measured: IoU 0).  With the occlusion check those frames are held: the window moves but
+    keeps its size, and neither the filters, the colour histograms nor the template learn; she is tracked at frame
+    75.  Held frames are checked against the models' state before them."""
+    seq = load_sequence("Jogging-2", otb_root)
+    frames = [read_frame(path) for path in seq.frame_paths[:76]]
+    default = TrackerConfig().update_confidence
+    assert default > 0
+    overlaps, held = {}, {}
+    for threshold in (0.0, default):
+        tracker = IemdTracker(TrackerConfig(update_confidence=threshold))
+        tracker.init(frames[0], seq.gt_boxes[0])
+        held[threshold] = []
+        for k, frame in enumerate(frames[1:], start=1):
+            before = (tracker._size.copy(), tracker._translation_filter._filter._numerator.copy(),
+                      tracker._scale_filter._filter._numerator.copy(), tracker._colour_model._target.copy(),
+                      np.array(tracker.dictionary.templates))
+            result = tracker.update(frame)
+            assert not result.lost
+            if result.held:
+                held[threshold].append(k)
+                after = (tracker._size, tracker._translation_filter._filter._numerator,
+                         tracker._scale_filter._filter._numerator, tracker._colour_model._target,
+                         np.array(tracker.dictionary.templates))
+                assert all(np.array_equal(a, b) for a, b in zip(before, after)), k
+                assert result.scale == 1.0 and "models not updated" in result.reason
+        overlaps[threshold] = float(iou(result.box, seq.gt_boxes[75]).ravel()[0])
+    assert held[0.0] == []
+    assert len(set(held[default]) & set(range(45, 61))) >= 12, held[default]
+    assert overlaps[0.0] < 0.1 and overlaps[default] > 0.5, overlaps
 
 
 def test_scale_bounds_keep_the_window_between_a_few_pixels_and_the_image():
