@@ -92,7 +92,10 @@ class TrackerConfig:
     # 8.2-9.6 candidate models per frame against 6.7-7.4 (Woman, Bolt2, David).  Weights 0.7 / 1.5 scored 39.0 /
     # 37.2 %, within the spread of such runs; with the colour model 0.5 / 1.5 scored 41.4 / 41.1 % against 42.8 %.
     # Not updating the template and the two filters on frames whose response at the kept window is below 0.2 / 0.35
-    # (against learning an occluder) scored 34.4 / 33.2 %.
+    # (against learning an occluder) scored 34.4 / 33.2 %; relative to the response's running mean, and keeping the
+    # size too, it is update_confidence below.  The response divided by that running mean (about 1 on the target in
+    # every sequence; raw, 0.1-0.2 on Woman and 0.3-0.4 on Jogging-2) at weights 0.35 / 0.5 / 0.7 scored 43.4 / 44.5 /
+    # 42.0 % over the 5 starts against 47.6 % unscaled (59.3 % from the ground truth alone at 0.5, against 53.5 %).
     translation_weight: float = 1.0
     # Colour evidence (iemd_ros/colour_model.py, Staple's foreground/background colour histograms), on colour frames
     # only: the window of highest mean colour score is one more start, and colour_weight x that mean at a window is
