@@ -133,6 +133,10 @@ class TrackerConfig:
     # Letting held frames change the size (46.0 %), a running mean over every tracked frame (43.5 %), a slower
     # mean (rate 0.03: 44.4 %) and learning anyway after 10 / 30 held frames in a row (46.7 / 46.2 %) scored lower.
     # Bolt2 loses (30.2 to 21.1 % over the 5 starts): a sprinter's fast change of pose also lowers the response.
+    # The search also prefers a descended window that the check would not hold to one it would (_search): Woman,
+    # frame 125, a car hiding her legs: the EMD pulled the window 20 px down, where the response was 0.02 (0.11 on
+    # her), and she was lost (17.3 %; 73.1 % with the preference).  With it 48.2 / 49.3 / 44.8 % over the 5 / axis
+    # / scaled starts, against 47.6 / 47.9 / 45.0 % without.
     update_confidence: float = 0.6
     # Descend every start and keep the window of lowest score: 40.0 % over the same 60 runs, at 14.2-18.8 models
     # per frame (about 1.8x the update time).  With it, weights 0.5 / 2 scored 37.4 / 35.7 %, keeping the lowest
@@ -492,7 +496,8 @@ class IemdTracker:
         ``fine_starts`` skip the coarse stage: the flow start, which pyramidal Lucas-Kanade already
         placed coarse to fine, the translation filter's and the colour model's.  The start of lowest EMD is
         refined, and with the translation filter or the colour model also the start of lowest :meth:`_score` (or
-        every start: ``descend_all_starts``); the refined window of lowest score is kept.  ``prediction`` is the
+        every start: ``descend_all_starts``); the refined window of lowest score is kept, among those the occlusion
+        check would not hold when there are any (:meth:`_confidence_check`).  ``prediction`` is the
         predicted centre, from which the score's motion prior measures a window's displacement.
 
         The appearance EMD is minimal at the target, but its basin is only about
@@ -537,7 +542,8 @@ class IemdTracker:
                 checked = min(models, key=lambda model: self._score(model.emd()[0], model.center, prediction, size))
                 chosen += [checked] if checked is not chosen[0] else []
         descents = [self._descend(model) for model in chosen]
-        best = min(descents, key=lambda state: self._score(state.emd, state.center, prediction, size))
+        confident = [state for state in descents if not self._confidence_check(state.center)[1]]
+        best = min(confident or descents, key=lambda state: self._score(state.emd, state.center, prediction, size))
         best.codings = len(models) + sum(state.codings for state in descents)
         best.warnings = warnings + sum(state.warnings for state in descents)
         return best
