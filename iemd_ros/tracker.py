@@ -237,6 +237,8 @@ class _Descent:
     iterations: int = 0
     codings: int = 0  # candidate models built (_descend: its trial steps; _search adds the starts')
     warnings: int = 0  # EMD solves that did not end optimal (likewise: the trials', the starts' by _search)
+    confidence: float | None = None  # the occlusion check at the window (set by _search: _confidence_check)
+    held_reason: str = ""
 
     @property
     def center(self) -> np.ndarray:
@@ -354,20 +356,20 @@ class IemdTracker:
             searches.append(candidate)
             if candidate.emd < best.emd:
                 best = candidate
-        confidence, held_reason = self._confidence_check(best.center)
-        bounds = _scale_bounds(best.model.size, frame.shape)
-        if held_reason:
-            final, scale = _Descent(model=best.model, emd=best.emd), 1.0
-        elif self._scale_filter is not None:
-            # The scale filter's estimate at the converged centre.  The window is not coded and solved again at the
-            # new size: the EMD barely sees scale (scale_filter.py), and the template Algorithm 2 learns is resampled
-            # to the template size anyway.  Solving it there changed nothing over 12 OTB sequences x 5 starts (38.6 %
-            # mean average overlap either way) and cost 0.5-0.8 ms per frame (one candidate model); with the true
-            # centre set before each frame (benchmarks/scale_curve.py) the size error is 13.1 % against 12.3 %.
-            scale = self._scale_filter.estimate(pyramid, best.center, best.model.size, best.model.angle, bounds)
-            final = _Descent(model=best.model, emd=best.emd)
-        else:
-            final, scale = self._search_scale(best, bounds)
+        confidence, held_reason = best.confidence, best.held_reason
+        final, scale = _Descent(model=best.model, emd=best.emd), 1.0  # a held frame keeps the window's size
+        if not held_reason:
+            bounds = _scale_bounds(best.model.size, frame.shape)
+            if self._scale_filter is not None:
+                # The scale filter's estimate at the converged centre.  The window is not coded and solved again at
+                # the new size: the EMD barely sees scale (scale_filter.py), and the template Algorithm 2 learns is
+                # resampled to the template size anyway.  Solving it there changed nothing over 12 OTB sequences x 5
+                # starts (38.6 % mean average overlap either way) and cost 0.5-0.8 ms per frame (one candidate
+                # model); with the true centre set before each frame (benchmarks/scale_curve.py) the size error is
+                # 13.1 % against 12.3 %.
+                scale = self._scale_filter.estimate(pyramid, best.center, best.model.size, best.model.angle, bounds)
+            else:
+                final, scale = self._search_scale(best, bounds)
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
         best_box = _box(new_center, new_size, angle)
         reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
@@ -542,7 +544,9 @@ class IemdTracker:
                 checked = min(models, key=lambda model: self._score(model.emd()[0], model.center, prediction, size))
                 chosen += [checked] if checked is not chosen[0] else []
         descents = [self._descend(model) for model in chosen]
-        confident = [state for state in descents if not self._confidence_check(state.center)[1]]
+        for state in descents:
+            state.confidence, state.held_reason = self._confidence_check(state.center)
+        confident = [state for state in descents if not state.held_reason]
         best = min(confident or descents, key=lambda state: self._score(state.emd, state.center, prediction, size))
         best.codings = len(models) + sum(state.codings for state in descents)
         best.warnings = warnings + sum(state.warnings for state in descents)
