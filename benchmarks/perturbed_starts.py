@@ -23,6 +23,7 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import TrackerConfig
+from iemd_ros.boxes import box_centre, centre_box
 from iemd_ros.evaluation import make_tracker, run_tracker, sequence_names
 from iemd_ros.metrics import score_sequence
 from iemd_ros.otb import default_root, load_sequence
@@ -37,9 +38,7 @@ START_SETS = {"diagonal": DIAGONALS, "sre": DIAGONALS + AXES + SCALES}
 def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: float) -> np.ndarray:
     """The box (x, y, w, h) ``first`` with its centre moved by (dx, dy) x ``shift`` x its size, then scaled by
     ``scale`` about that centre."""
-    centre = first[:2] + first[2:] / 2.0 + np.array([dx, dy]) * shift * first[2:]
-    size = first[2:] * scale
-    return np.concatenate([centre - size / 2.0, size])
+    return centre_box(box_centre(first) + np.array([dx, dy]) * shift * first[2:], first[2:] * scale)
 
 
 def run(job):
