@@ -17,7 +17,7 @@ from setuptools import find_packages, setup
 PACKAGE = "iemd_ros"
 HERE = os.path.dirname(os.path.abspath(__file__))
 # ros2 run executables: name -> module with main()
-EXECUTABLES = {"tracker": "iemd_ros.node", "replay": "iemd_ros.replay"}
+EXECUTABLES = {"tracker": "iemd_ros.ros.node", "replay": "iemd_ros.bags.replay"}
 WRAPPER_DIR = os.path.join("build", "ros_executables")
 
 WRAPPER = '''#!/bin/sh
@@ -74,12 +74,12 @@ setup(
     tests_require=["pytest"],
     entry_points={
         "console_scripts": [
-            "iemd-demo = iemd_ros.demo:main",
-            "iemd-eval = iemd_ros.evaluation:main",
-            "iemd-tracker = iemd_ros.node:main",
-            "iemd-replay = iemd_ros.replay:main",
-            "iemd-make-bag = iemd_ros.bag_make:main",
-            "iemd-play = iemd_ros.bag_play:main",
+            "iemd-demo = iemd_ros.apps.demo:main",
+            "iemd-eval = iemd_ros.evaluation.ope:main",
+            "iemd-tracker = iemd_ros.ros.node:main",
+            "iemd-replay = iemd_ros.bags.replay:main",
+            "iemd-make-bag = iemd_ros.bags.make:main",
+            "iemd-play = iemd_ros.bags.play:main",
         ],
     },
 )

@@ -20,10 +20,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.cli import CliParser, cli_main
-from iemd_ros.evaluation import TRACKERS, make_tracker, run_tracker
-from iemd_ros.otb import default_root, list_sequences, load_sequence
-from iemd_ros.recordings import load_recording
+from iemd_ros.common.cli import CliParser, cli_main
+from iemd_ros.evaluation.ope import TRACKERS, make_tracker, run_tracker
+from iemd_ros.datasets.otb import default_root, list_sequences, load_sequence
+from iemd_ros.datasets.recordings import load_recording
 
 DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
 

@@ -5,7 +5,7 @@
 
 Each variant sets a few fields of ``cv2.TrackerCSRT_Params`` (the rest are OpenCV's defaults, which
 ``iemd-eval`` runs) and tracks every sequence once from the ground truth; printed: the average overlap
-per sequence (iemd_ros.metrics), per variant.  The README ("Where the gap to CSRT is") quotes it.
+per sequence (iemd_ros.evaluation.metrics), per variant.  The README ("Where the gap to CSRT is") quotes it.
 """
 from __future__ import annotations
 
@@ -15,9 +15,9 @@ from multiprocessing import Pool
 
 import cv2
 
-from iemd_ros.evaluation import OpenCVTracker, run_tracker, sequence_names
-from iemd_ros.metrics import score_sequence
-from iemd_ros.otb import default_root, load_sequence
+from iemd_ros.evaluation.ope import OpenCVTracker, run_tracker, sequence_names
+from iemd_ros.evaluation.metrics import score_sequence
+from iemd_ros.datasets.otb import default_root, load_sequence
 
 VARIANTS = {
     "defaults": {},

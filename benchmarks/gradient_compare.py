@@ -22,8 +22,8 @@ import cv2
 import numpy as np
 
 from iemd_ros import IemdTracker
-from iemd_ros.boxes import box_centre, centre_box
-from iemd_ros.otb import default_root, load_sequence, read_frame
+from iemd_ros.common.boxes import box_centre, centre_box
+from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
 
 GRADIENTS = ("paper", "envelope", "appearance")
 CASES = ("next frame", "known shift")

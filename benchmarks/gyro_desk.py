@@ -5,7 +5,7 @@ The tracker is initialised on the first frame whose GT flag is ``ok`` and run ca
 raw (distorted) frames; the gyro prior for frame k is the lens-aware local homography at the
 tracker's current window (``GyroPredictor.predict``), integrated from the frame the window belongs
 to (after a frame reported lost, the tracker keeps its previous window, so the rotation is
-integrated from that frame).  Scores (iemd_ros.metrics) over the first 100 frames (the paper's
+integrated from that frame).  Scores (iemd_ros.evaluation.metrics) over the first 100 frames (the paper's
 sequence length) and over the whole sequence, from the init frame on (the init frame included, as
 in OTB); frames whose GT is absent are excluded (the desk GT has none).  Both modes use the
 tracker's scale estimator (``--scale-estimator``); with the paper's EMD scale variants, the ±10 %
@@ -23,8 +23,8 @@ from pathlib import Path
 import numpy as np
 
 from iemd_ros import TrackerConfig
-from iemd_ros.metrics import score_sequence
-from iemd_ros.recordings import load_recording, track_recording
+from iemd_ros.evaluation.metrics import score_sequence
+from iemd_ros.datasets.recordings import load_recording, track_recording
 
 DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu"
 

@@ -17,9 +17,9 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.gyro import rotation_homography, warp_difference
-from iemd_ros.recordings import load_recording
-from iemd_ros.rotation import rotation_angle
+from iemd_ros.gyro.predictor import rotation_homography, warp_difference
+from iemd_ros.datasets.recordings import load_recording
+from iemd_ros.gyro.rotation import rotation_angle
 
 DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu"
 SEQUENCES = {"desk": "cmu_hwangbo_desk", "aerial": "cmu_hwangbo_aerial",

@@ -31,10 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-import iemd_ros.imu
-import iemd_ros.pipeline
-import iemd_ros.rotation
-from iemd_ros.cli import CliParser, cli_main
+import iemd_ros.gyro.imu
+import iemd_ros.pipeline.pipeline
+import iemd_ros.gyro.rotation
+from iemd_ros.common.cli import CliParser, cli_main
 
 ROOT = Path(__file__).resolve().parents[1]
 BASELINE = "8e58e6b"      # the last commit before the one-pass IMU screening and quat_to_rot's single build
@@ -131,7 +131,7 @@ def _main(argv) -> int:
         raise ValueError(f"--repeats must be >= 1, got {args.repeats}")
     with tempfile.TemporaryDirectory() as tmp:
         old = load_baseline(args.baseline, Path(tmp))
-        new = (iemd_ros.imu, iemd_ros.pipeline, iemd_ros.rotation)
+        new = (iemd_ros.gyro.imu, iemd_ros.pipeline.pipeline, iemd_ros.gyro.rotation)
         check_same(old[0], new[0])
         old_cases, new_cases = cases(*old), cases(*new)
         for (make, n, _), (make_new, _, _) in zip(old_cases.values(), new_cases.values()):

@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from iemd_ros.rotation import integrate_first_order, integrate_rates, quat_to_rot, rotation_angle, so3_exp
-from iemd_ros.synthetic import SyntheticConfig, angular_velocity
+from iemd_ros.gyro.rotation import integrate_first_order, integrate_rates, quat_to_rot, rotation_angle, so3_exp
+from iemd_ros.datasets.synthetic import SyntheticConfig, angular_velocity
 
 F_PX = 570.0
 DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu"
@@ -80,7 +80,7 @@ def shaking(peak_dps: float, n_frames: int = 300) -> None:
 
 
 def desk(root: Path) -> None:
-    from iemd_ros.recordings import load_recording
+    from iemd_ros.datasets.recordings import load_recording
 
     rec = load_recording(root / "cmu_hwangbo_desk")
     t, w = rec.gyro_predictor().buffer.samples()    # the whole record, sorted, repeats merged

@@ -7,7 +7,7 @@ with sensor-data QoS, as a camera driver would, and times each frame from just b
 to the arrival of the Detection2DArray carrying its stamp (both on the driver's clock).  Setups:
 
 * ``inproc``: tracker node and driver in one process (one DDS participant);
-* ``process``: the tracker as its own process (``python -m iemd_ros.node``), default transport;
+* ``process``: the tracker as its own process (``python -m iemd_ros.ros.node``), default transport;
 * ``process-shm``: the same with ``config/fastdds_shm.xml`` (FASTRTPS_DEFAULT_PROFILES_FILE) in both;
 * ``process-jpeg``: the tracker process with ``image_transport`` "compressed", the frames published as
   JPEG (quality 95) CompressedImage on ``image/compressed``; its latency includes the decoding
@@ -48,7 +48,7 @@ def _add_echo(node, reliable: bool, compressed: bool) -> None:
     from sensor_msgs.msg import CompressedImage, Image
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.conversions import compressed_topic
+    from iemd_ros.messages.conversions import compressed_topic
 
     pub = node.create_publisher(Detection2DArray, "detections", 10)
 
@@ -67,7 +67,7 @@ def _echo_main(reliable: bool, compressed: bool) -> int:
     """--serve-echo: the echo as its own process."""
     import rclpy
 
-    from iemd_ros.spin import spin_until_shutdown
+    from iemd_ros.ros.spin import spin_until_shutdown
 
     rclpy.init()
     node = rclpy.create_node("iemd_echo")
@@ -85,7 +85,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.conversions import (array_to_compressed_fields, compressed_topic, fill_image_msg, ns_to_stamp,
+    from iemd_ros.messages.conversions import (array_to_compressed_fields, compressed_topic, fill_image_msg, ns_to_stamp,
                                       stamp_ns)
 
     env = dict(os.environ)             # the caller set FASTRTPS_DEFAULT_PROFILES_FILE for -shm
@@ -100,7 +100,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     try:
         if setup == "inproc":
             if subject == "tracker":
-                from iemd_ros.node import TrackerNode
+                from iemd_ros.ros.node import TrackerNode
                 nodes.append(TrackerNode(context=context, parameter_overrides=[
                     Parameter(k, value=v) for k, v in params.items()]))
             else:
@@ -109,7 +109,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
                 nodes.append(echo)
         else:
             if subject == "tracker":
-                cmd = [sys.executable, "-m", "iemd_ros.node", "--ros-args"]
+                cmd = [sys.executable, "-m", "iemd_ros.ros.node", "--ros-args"]
                 for k, v in params.items():
                     cmd += ["-p", f"{k}:={str(v).lower() if isinstance(v, bool) else v}"]
             else:
@@ -223,7 +223,7 @@ def main(argv=None) -> int:
     if args.serve_echo:
         return _echo_main(args.reliable, args.compressed)
     if args.measure:
-        from iemd_ros.synthetic import generate
+        from iemd_ros.datasets.synthetic import generate
         seq = generate(n_frames=args.frames, width=args.width, height=args.height, max_rate_deg_s=60.0,
                        target_size_px=64.0, seed=1)
         print("RESULT " + json.dumps(_run(args, seq, *args.measure)))

@@ -25,12 +25,12 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import IemdTracker
-from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.boxes import box_centre, centre_box
-from iemd_ros.candidate import CandidateModel
-from iemd_ros.metrics import iou
-from iemd_ros.evaluation import sequence_names
-from iemd_ros.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.appearance import ImagePyramid, to_gray
+from iemd_ros.common.boxes import box_centre, centre_box
+from iemd_ros.tracking.candidate import CandidateModel
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.evaluation.ope import sequence_names
+from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
 
 OFFSETS = np.linspace(-0.6, 0.6, 13)
 CAPTURE_STARTS = (0.05, 0.1, 0.2, 0.3, 0.4)

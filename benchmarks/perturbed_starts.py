@@ -10,7 +10,7 @@ tracker whose result swings with small changes says little.  As OTB's spatial ro
 along the four diagonals (5 starts in all); with ``--starts sre`` also along the four axes and with
 the box scaled by 0.8, 0.9, 1.1 and 1.2 about its centre (13 starts: OTB's 8 spatial shifts and 4 scale
 variations, and the ground truth).  Each run is scored over all its frames against the ground truth
-(iemd_ros.metrics).  Printed per tracker: the mean average overlap over sequences and
+(iemd_ros.evaluation.metrics).  Printed per tracker: the mean average overlap over sequences and
 starts, its mean per start, per sequence, and the median update time.  ``--config`` runs iEMD with
 other TrackerConfig values (default: the defaults), each against the same peers.
 """
@@ -23,10 +23,10 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import TrackerConfig
-from iemd_ros.boxes import box_centre, centre_box
-from iemd_ros.evaluation import make_tracker, run_tracker, sequence_names
-from iemd_ros.metrics import score_sequence
-from iemd_ros.otb import default_root, load_sequence
+from iemd_ros.common.boxes import box_centre, centre_box
+from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
+from iemd_ros.evaluation.metrics import score_sequence
+from iemd_ros.datasets.otb import default_root, load_sequence
 
 # Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, and the box's scale.
 DIAGONALS = ((0.0, 0.0, 1.0), (1.0, 1.0, 1.0), (-1.0, 1.0, 1.0), (1.0, -1.0, 1.0), (-1.0, -1.0, 1.0))

@@ -5,7 +5,7 @@ Makes the desk bag with ``iemd-make-bag`` (mcap, bgr8, 640x480 at 30 fps, 100 Hz
 folder, then measures in the same run:
 
 * the bag I/O alone (read + CDR decode + ``image_to_array`` of every message): the replay's floor;
-* the full offline replay (``iemd_ros.replay.replay``: synchronization, gyro prediction, tracker), with
+* the full offline replay (``iemd_ros.bags.replay.replay``: synchronization, gyro prediction, tracker), with
   the gyro prior and, with ``--no-gyro-too``, without it;
 * with ``--compress jpeg png``: the same frames as ``sensor_msgs/CompressedImage`` bags
   (``iemd-make-bag --compress``), bag I/O (now with the image decoding) and replay with the gyro, and the
@@ -28,11 +28,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from iemd_ros.bag_io import deserialize, iter_messages, open_bag, select_topics
-from iemd_ros.bag_make import source_from_folder, write_bag
-from iemd_ros.conversions import COMPRESSED_CODECS, image_from_msg
-from iemd_ros.metrics import iou
-from iemd_ros.replay import replay
+from iemd_ros.bags.io import deserialize, iter_messages, open_bag, select_topics
+from iemd_ros.bags.make import source_from_folder, write_bag
+from iemd_ros.messages.conversions import COMPRESSED_CODECS, image_from_msg
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.bags.replay import replay
 
 DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
 

@@ -28,11 +28,11 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.boxes import box_centre
-from iemd_ros.candidate import CandidateModel
-from iemd_ros.evaluation import sequence_names
-from iemd_ros.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.appearance import ImagePyramid, to_gray
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.candidate import CandidateModel
+from iemd_ros.evaluation.ope import sequence_names
+from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
 
 SCALES = np.exp(np.linspace(np.log(0.8), np.log(1.25), 23))  # 2.0 % apart; SCALES[11] = 1
 SHOWN = (0, 4, 8, 10, 12, 14, 18, 22)  # 0.80, 0.87, 0.94, 0.98, 1.02, 1.06, 1.15, 1.25

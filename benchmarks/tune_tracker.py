@@ -20,11 +20,11 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.evaluation import evaluate_sequence, make_tracker
-from iemd_ros.boxes import box_centre
-from iemd_ros.candidate import CandidateModel
-from iemd_ros.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.appearance import ImagePyramid, to_gray
+from iemd_ros.evaluation.ope import evaluate_sequence, make_tracker
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.candidate import CandidateModel
+from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
 
 
 def overlap(job):

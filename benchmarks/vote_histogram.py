@@ -7,7 +7,7 @@ Default: every sequence in ../shared/data/otb.
 
 Section 4 can be read two ways.
 
-(a) The tracker's (iemd_ros.candidate): every local patch r is a bin; its mass is its pooled code
+(a) The tracker's (iemd_ros.tracking.candidate): every local patch r is a bin; its mass is its pooled code
     weight ||a_bar_r||_inf times the kernel, and its appearance eps_r and position c_r enter the
     ground distance.
 (b) A vote histogram: the K bins are the dictionary's patch positions; every densely sampled patch r
@@ -33,13 +33,13 @@ from multiprocessing import Pool
 import numpy as np
 
 from iemd_ros import IemdTracker
-from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
-from iemd_ros.boxes import box_centre
-from iemd_ros.candidate import CandidateModel
-from iemd_ros.emd import ground_distance, solve_emd
-from iemd_ros.histogram import candidate_weights
-from iemd_ros.evaluation import sequence_names
-from iemd_ros.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.candidate import CandidateModel
+from iemd_ros.tracking.emd import ground_distance, solve_emd
+from iemd_ros.tracking.histogram import candidate_weights
+from iemd_ros.evaluation.ope import sequence_names
+from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
 from model_ceiling import grid_argmin  # benchmarks/ is the script's directory
 
 OFFSETS = np.linspace(-0.4, 0.4, 9)

@@ -2,6 +2,6 @@
 
 The tracker core is ROS-free: ``from iemd_ros import IemdTracker``.
 """
-from .tracker import IemdTracker, TrackerConfig, TrackResult
+from iemd_ros.tracking.tracker import IemdTracker, TrackerConfig, TrackResult
 
 __all__ = ["IemdTracker", "TrackerConfig", "TrackResult"]

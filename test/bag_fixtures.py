@@ -3,10 +3,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from iemd_ros.bag_io import open_bag
-from iemd_ros.conversions import compressed_topic, stamp_ns
-from iemd_ros.bag_make import DEFAULT_TOPICS, source_from_synthetic, write_bag
-from iemd_ros.synthetic import generate
+from iemd_ros.bags.io import open_bag
+from iemd_ros.messages.conversions import compressed_topic, stamp_ns
+from iemd_ros.bags.make import DEFAULT_TOPICS, source_from_synthetic, write_bag
+from iemd_ros.datasets.synthetic import generate
 
 N_FRAMES = 12
 # the topics iemd-make-bag writes

@@ -25,7 +25,7 @@ def otb_root() -> Path:
 @pytest.fixture
 def car4_first(otb_root):
     """Car4's first frame (BGR) and its ground-truth box (x, y, w, h), the real texture of several tests."""
-    from iemd_ros.otb import load_sequence, read_frame
+    from iemd_ros.datasets.otb import load_sequence, read_frame
 
     seq = load_sequence(otb_root / "Car4")
     return read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0], dtype=float)

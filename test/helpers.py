@@ -14,7 +14,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.conversions import bbox_to_box, bbox_values
+from iemd_ros.messages.conversions import bbox_to_box, bbox_values
 
 REPO = Path(__file__).resolve().parents[1]
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"

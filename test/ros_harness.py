@@ -18,7 +18,7 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray
 
-from iemd_ros.conversions import (array_to_compressed_fields, box_to_bbox, compressed_topic, fill_bbox, fill_image_msg,
+from iemd_ros.messages.conversions import (array_to_compressed_fields, box_to_bbox, compressed_topic, fill_bbox, fill_image_msg,
                                   ns_to_stamp)
 
 FRAME_ID = "synthetic_cam"

@@ -26,11 +26,11 @@ from ros_harness import spinning  # noqa: E402
 from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu  # noqa: E402
 from vision_msgs.msg import Detection2DArray  # noqa: E402
 
-from iemd_ros.bag_make import source_from_folder, write_bag  # noqa: E402
-from iemd_ros.bag_play import main, play  # noqa: E402
-from iemd_ros.conversions import stamp_ns  # noqa: E402
-from iemd_ros.pipeline import PipelineConfig  # noqa: E402
-from iemd_ros.replay import replay  # noqa: E402
+from iemd_ros.bags.make import source_from_folder, write_bag  # noqa: E402
+from iemd_ros.bags.play import main, play  # noqa: E402
+from iemd_ros.messages.conversions import stamp_ns  # noqa: E402
+from iemd_ros.pipeline.pipeline import PipelineConfig  # noqa: E402
+from iemd_ros.bags.replay import replay  # noqa: E402
 
 BOX_TOL_PX = 1e-6
 LIVE_RATE = 0.05  # the node must keep up on a loaded 2-core machine (~100-300 ms per update)
@@ -120,7 +120,7 @@ def test_play_compressed(ctx, seq, tmp_path, fmt, name):
 
 def _live_vs_offline(ctx, bag, init, n_frames):
     """Play ``bag`` at LIVE_RATE into a TrackerNode; return (live {stamp: Detection2DArray}, dropped, node counters)."""
-    from iemd_ros.node import TrackerNode
+    from iemd_ros.ros.node import TrackerNode
 
     params = [Parameter("initial_box", value=[float(v) for v in init]),
               Parameter("imu_wait_ms", value=IMU_WAIT_MS), Parameter("reliable_qos", value=True)]

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from helpers import DESK_D, DESK_INFO, DESK_K, DESK_K_DATA
 
-from iemd_ros.camera import CameraModel
+from iemd_ros.gyro.camera import CameraModel
 
 
 def grid(w, h, step=4):

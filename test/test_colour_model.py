@@ -4,10 +4,10 @@ import pytest
 
 from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.boxes import box_centre
-from iemd_ros.colour_model import ColourModel
-from iemd_ros.metrics import iou
-from iemd_ros.otb import load_sequence, read_frame
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.colour_model import ColourModel
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.datasets.otb import load_sequence, read_frame
 
 RED, GREEN, BLUE = (0, 0, 255), (0, 255, 0), (255, 0, 0)  # BGR
 

@@ -6,12 +6,12 @@ import cv2
 import numpy as np
 import pytest
 
-from iemd_ros.boxes import box_centre, centre_box, check_box
-from iemd_ros.conversions import (array_to_compressed_fields, array_to_image_fields, bbox_to_box, bbox_values,
+from iemd_ros.common.boxes import box_centre, centre_box, check_box
+from iemd_ros.messages.conversions import (array_to_compressed_fields, array_to_image_fields, bbox_to_box, bbox_values,
                                   box_to_bbox, camera_model_from_info, compressed_to_array, detection_values,
                                   fill_bbox, fill_image_msg, image_from_msg, image_to_array, imu_sample, ns_to_stamp,
                                   stamp_to_ns)
-from iemd_ros.pipeline import FrameResult
+from iemd_ros.pipeline.pipeline import FrameResult
 
 
 @pytest.fixture

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from iemd_ros.correlation_filter import FLOOR, FilterModel, hann, model_size, orientation_histograms, parabola_peak
+from iemd_ros.tracking.correlation_filter import FLOOR, FilterModel, hann, model_size, orientation_histograms, parabola_peak
 
 
 def test_orientation_histograms_of_edges_by_hand():

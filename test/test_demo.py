@@ -3,10 +3,10 @@ writes the plot -- with no data from ../shared."""
 import numpy as np
 from helpers import PNG_SIGNATURE, csv_boxes
 
-from iemd_ros.demo import main
-from iemd_ros.metrics import iou
-from iemd_ros.otb import parse_groundtruth
-from iemd_ros.replay import replay
+from iemd_ros.apps.demo import main
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.datasets.otb import parse_groundtruth
+from iemd_ros.bags.replay import replay
 
 N = 12
 

@@ -1,8 +1,8 @@
 """draw_result: the node's debug image and the replay's video frames."""
 import numpy as np
 
-from iemd_ros.drawing import GYRO, INIT, LOST, TRACKING, draw_result
-from iemd_ros.pipeline import FrameResult
+from iemd_ros.pipeline.drawing import GYRO, INIT, LOST, TRACKING, draw_result
+from iemd_ros.pipeline.pipeline import FrameResult
 
 
 def _pixels(img, colour):

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
-from iemd_ros.emd import appearance_distance, ground_distance, solve_emd, spatial_distance
+from iemd_ros.tracking.emd import appearance_distance, ground_distance, solve_emd, spatial_distance
 
 
 def linprog_emd(w_t, w_c, cost):

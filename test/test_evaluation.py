@@ -1,4 +1,4 @@
-"""iemd-eval end to end (iemd_ros.evaluation): protocol wiring on synthetic data, CLI on real OTB frames."""
+"""iemd-eval end to end (iemd_ros.evaluation.ope): protocol wiring on synthetic data, CLI on real OTB frames."""
 import json
 from pathlib import Path
 
@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 from helpers import PNG_SIGNATURE, cli_error, node_parameter_file, run_module
 
-from iemd_ros import TrackerConfig, evaluation
-from iemd_ros.evaluation import main, make_tracker, run_tracker, sequence_names
-from iemd_ros.otb import load_sequence
+from iemd_ros import TrackerConfig
+from iemd_ros.evaluation import ope as evaluation
+from iemd_ros.evaluation.ope import main, make_tracker, run_tracker, sequence_names
+from iemd_ros.datasets.otb import load_sequence
 
 # Measured on Car4 frames 1-20 (OpenCV 5.0.0 contrib): CSRT average overlap 85.8 %, KCF 87.9 %.
 CSRT_CAR4_20_MIN_OVERLAP = 0.75
@@ -148,7 +149,7 @@ def test_bad_arguments_exit_2_one_line(argv, match, capsys):
 
 
 def test_bad_argument_subprocess_no_traceback(tmp_path):
-    proc = run_module("iemd_ros.evaluation", str(tmp_path), "--trackers", "kcf", timeout=60)
+    proc = run_module("iemd_ros.evaluation.ope", str(tmp_path), "--trackers", "kcf", timeout=60)
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert "holds no OTB sequence" in proc.stderr

@@ -6,8 +6,8 @@ import pytest
 from helpers import shifted, texture
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import grey_levels
-from iemd_ros.flow import window_flow
+from iemd_ros.tracking.appearance import grey_levels
+from iemd_ros.tracking.flow import window_flow
 
 
 @pytest.fixture

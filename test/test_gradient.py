@@ -6,11 +6,11 @@ import pytest
 from helpers import shifted, texture
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
-from iemd_ros.boxes import box_centre
-from iemd_ros.candidate import CandidateModel
-from iemd_ros.emd import ground_distance, solve_emd, spatial_distance
-from iemd_ros.histogram import candidate_weights
+from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.candidate import CandidateModel
+from iemd_ros.tracking.emd import ground_distance, solve_emd, spatial_distance
+from iemd_ros.tracking.histogram import candidate_weights
 
 
 @pytest.fixture

@@ -3,14 +3,14 @@ import numpy as np
 import pytest
 from helpers import DESK_D, DESK_K
 
-from iemd_ros.boxes import box_centre
-from iemd_ros.camera import CameraModel
-from iemd_ros.gyro import (GyroConfig, GyroPredictor, box_grid, local_prior, predict_box,
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.gyro.camera import CameraModel
+from iemd_ros.gyro.predictor import (GyroConfig, GyroPredictor, box_grid, local_prior, predict_box,
                            rotation_homography, warp_difference, warp_points)
-from iemd_ros.imu import Coverage
-from iemd_ros.metrics import iou
-from iemd_ros.rotation import so3_exp
-from iemd_ros.synthetic import generate
+from iemd_ros.gyro.imu import Coverage
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.gyro.rotation import so3_exp
+from iemd_ros.datasets.synthetic import generate
 
 
 def run_predictor(seq, config=None, box_source="gt"):
@@ -165,7 +165,7 @@ def test_gyro_config_checks_itself():
 
 def test_real_desk_prewarp_direction(imu_root):
     """On the 6 fastest desk pairs K R^T K^-1 cuts the grey-level error; K R K^-1 raises it."""
-    from iemd_ros.recordings import load_recording
+    from iemd_ros.datasets.recordings import load_recording
 
     rec = load_recording(imu_root / "cmu_hwangbo_desk")
     pred = GyroPredictor(rec.camera, GyroConfig(time_offset_ns=rec.time_offset_ns, buffer_ns=10 ** 12))
@@ -205,7 +205,7 @@ def test_real_desk_close_up_with_roll_is_tracked_with_the_gyro(imu_root):
     """CMU desk frames 500-580: the camera closes in on the eagle's head and rolls it by ~160 deg.
     Measured: mean IoU 0.73 (min 0.65) with the gyro prior, the window turning to -160 deg; without it 0.46,
     the last 20 frames at most 0.30 (0.17 over all frames before the translation filter)."""
-    from iemd_ros.recordings import load_recording, track_recording
+    from iemd_ros.datasets.recordings import load_recording, track_recording
 
     rec = load_recording(imu_root / "cmu_hwangbo_desk")
     start, stop = 500, 580

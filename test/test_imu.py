@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from iemd_ros.imu import Coverage, ImuBuffer, SampleStatus
-from iemd_ros.rotation import GyroCalibration, integrate_rates, quat_to_rot, rotation_angle, so3_exp
+from iemd_ros.gyro.imu import Coverage, ImuBuffer, SampleStatus
+from iemd_ros.gyro.rotation import GyroCalibration, integrate_rates, quat_to_rot, rotation_angle, so3_exp
 
 MS = 1_000_000
 T0 = 5_000_000_000          # an arbitrary clock origin (ns)
@@ -224,7 +224,7 @@ def test_bad_input_raises():
 
 
 def test_real_desk_log_step_backs(imu_root):
-    from iemd_ros.recordings import load_recording
+    from iemd_ros.datasets.recordings import load_recording
 
     rec = load_recording(imu_root / "cmu_hwangbo_desk")
     buf = ImuBuffer(max_duration_ns=10 ** 12)

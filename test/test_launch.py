@@ -14,7 +14,7 @@ import yaml
 from catkin_pkg import package as catkin_package
 from helpers import REPO
 
-from iemd_ros.pipeline import NODE_NAME
+from iemd_ros.pipeline.pipeline import NODE_NAME
 
 LAUNCH = REPO / "launch" / "tracker.launch.xml"
 SUBSTITUTION = re.compile(r"\$\((\S+)\s+([^)]*)\)")
@@ -58,7 +58,7 @@ def test_node_is_the_packages_tracker_executable_named_as_its_parameter_file_say
     setup = ast.parse((REPO / "setup.py").read_text())
     executables = next(ast.literal_eval(n.value) for n in ast.walk(setup)
                        if isinstance(n, ast.Assign) and getattr(n.targets[0], "id", "") == "EXECUTABLES")
-    assert node.get("exec") in executables and executables[node.get("exec")] == "iemd_ros.node"
+    assert node.get("exec") in executables and executables[node.get("exec")] == "iemd_ros.ros.node"
     assert node.get("name") == NODE_NAME
     (params,) = [p for p in node.iter("param") if p.get("from")]
     params_file = REPO.joinpath(_resolve(params.get("from"), args))
@@ -68,7 +68,7 @@ def test_node_is_the_packages_tracker_executable_named_as_its_parameter_file_say
 
 
 def test_remaps_rename_topics_the_node_really_has(ctx):
-    rclpy_node = pytest.importorskip("iemd_ros.node")
+    rclpy_node = pytest.importorskip("iemd_ros.ros.node")
     root, args = _launch()
     (node,) = root.iter("node")
     tracker = rclpy_node.TrackerNode(context=ctx)

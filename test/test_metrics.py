@@ -1,8 +1,8 @@
-"""Hand-computed checks of the OTB metrics (iemd_ros.metrics)."""
+"""Hand-computed checks of the OTB metrics (iemd_ros.evaluation.metrics)."""
 import numpy as np
 import pytest
 
-from iemd_ros.metrics import (
+from iemd_ros.evaluation.metrics import (
     OTB_THRESHOLDS,
     average_overlap,
     center_error,

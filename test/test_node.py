@@ -15,10 +15,10 @@ from ros_harness import FRAME_ID, Driver, imu_msg, level, spinning, values  # no
 
 from sensor_msgs.msg import Image  # noqa: E402
 
-from iemd_ros.conversions import bbox_values, image_from_msg, stamp_ns  # noqa: E402
-from iemd_ros.boxes import box_centre  # noqa: E402
-from iemd_ros.node import TrackerNode  # noqa: E402
-from iemd_ros.synthetic import generate  # noqa: E402
+from iemd_ros.messages.conversions import bbox_values, image_from_msg, stamp_ns  # noqa: E402
+from iemd_ros.common.boxes import box_centre  # noqa: E402
+from iemd_ros.ros.node import TrackerNode  # noqa: E402
+from iemd_ros.datasets.synthetic import generate  # noqa: E402
 
 OK, WARN, ERROR = 0, 1, 2
 N = 40

@@ -14,8 +14,8 @@ pytest.importorskip("vision_msgs.msg")
 from ament_index_python.packages import PackageNotFoundError, get_package_prefix  # noqa: E402
 from ros_harness import Driver, child_env, isolated_ros_env, ros_context, spinning  # noqa: E402
 
-from iemd_ros.conversions import bbox_values, stamp_ns  # noqa: E402
-from iemd_ros.synthetic import generate  # noqa: E402
+from iemd_ros.messages.conversions import bbox_values, stamp_ns  # noqa: E402
+from iemd_ros.datasets.synthetic import generate  # noqa: E402
 
 
 def _prefix_env() -> dict:

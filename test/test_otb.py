@@ -1,11 +1,11 @@
-"""OTB-layout loading (iemd_ros.otb): GT parsing variants on tmp files and every real sequence."""
+"""OTB-layout loading (iemd_ros.datasets.otb): GT parsing variants on tmp files and every real sequence."""
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
-from iemd_ros.otb import list_sequences, load_sequence, parse_groundtruth, read_frame
+from iemd_ros.datasets.otb import list_sequences, load_sequence, parse_groundtruth, read_frame
 
 EXPECTED = np.array([[69.0, 50.0, 107.0, 87.0], [70.5, 49.0, 100.0, 80.0], [-1.0, 0.0, 3.0, 4.0]])
 

@@ -17,7 +17,7 @@ PIP_ONLY = {"numba": "numba", "ot": "POT", "rosbags": "rosbags"}
 def _imported_modules() -> set[str]:
     """Top-level modules imported anywhere in iemd_ros/ (also inside functions), absolute imports only."""
     names = set()
-    for path in (REPO / "iemd_ros").glob("*.py"):
+    for path in (REPO / "iemd_ros").rglob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Import):
                 names.update(alias.name.split(".")[0] for alias in node.names)

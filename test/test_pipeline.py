@@ -4,12 +4,12 @@ import math
 import numpy as np
 import pytest
 
-from iemd_ros.boxes import box_centre
-from iemd_ros.camera import CameraModel
-from iemd_ros.gyro import GyroConfig, GyroPredictor
-from iemd_ros.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
-from iemd_ros.synthetic import generate
-from iemd_ros.tracker import IemdTracker, TrackerConfig
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.gyro.camera import CameraModel
+from iemd_ros.gyro.predictor import GyroConfig, GyroPredictor
+from iemd_ros.pipeline.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
+from iemd_ros.datasets.synthetic import generate
+from iemd_ros.tracking.tracker import IemdTracker, TrackerConfig
 
 N = 24
 

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from iemd_ros.recordings import CMU_TIME_OFFSET_NS, load_recording
+from iemd_ros.datasets.recordings import CMU_TIME_OFFSET_NS, load_recording
 
 
 def test_cmu_desk(imu_root):

@@ -13,12 +13,12 @@ import pytest
 from bag_fixtures import IMG, IMG_COMPRESSED, IMU, INFO, by_topic, make_bag, read_all, shaky_sequence, stamps
 from helpers import cli_error, csv_boxes, detection_box, node_parameter_file, read_csv_rows, run_module
 
-from iemd_ros.bag_io import COMPRESSED_IMAGE_TYPE, IMAGE_TYPE, BagWriter
-from iemd_ros.bag_make import (_camera_info_msg, _compressed_msg, _image_msg, _imu_msg, source_from_folder,
+from iemd_ros.bags.io import COMPRESSED_IMAGE_TYPE, IMAGE_TYPE, BagWriter
+from iemd_ros.bags.make import (_camera_info_msg, _compressed_msg, _image_msg, _imu_msg, source_from_folder,
                                  write_bag, write_gt)
-from iemd_ros.cli import split_ros_args
-from iemd_ros.metrics import iou, score_sequence
-from iemd_ros.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
+from iemd_ros.common.cli import split_ros_args
+from iemd_ros.evaluation.metrics import iou, score_sequence
+from iemd_ros.bags.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
 
 N = 10
 BOTH_IMAGE_TYPES = "sensor_msgs/msg/Image or sensor_msgs/msg/CompressedImage"   # as the errors name them
@@ -248,7 +248,7 @@ def test_corrupt_compressed_frame_is_counted(seq, tmp_path):
     """A compressed frame that does not decode is treated as a malformed raw Image: a ``malformed`` row
     without a box, counted in the summary and the diagnostics, tracking goes on; the real process exits 0."""
     _bag_with(tmp_path / "cut", image_topics=(IMG_COMPRESSED,), seq=seq, bad_at=2, n=6)
-    out = run_module("iemd_ros.replay", str(tmp_path / "cut"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"),
+    out = run_module("iemd_ros.bags.replay", str(tmp_path / "cut"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"),
                      "--out-bag", str(tmp_path / "res"))
     assert out.returncode == 0 and "Traceback" not in out.stderr, out.stderr
     assert f"6 images from {IMG}/compressed: gyro prior on 0 frames, lost on 0, rejected 1;" in out.stdout
@@ -306,7 +306,7 @@ def test_cli_process_no_traceback(seq, tmp_path):
     """The real process on a truncated bag: exit status 2, one stderr line, no traceback."""
     make_bag(seq, tmp_path / "m", count=3)
     _truncate(next((tmp_path / "m").glob("*.mcap")), 0.7)
-    out = run_module("iemd_ros.replay", str(tmp_path / "m"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"))
+    out = run_module("iemd_ros.bags.replay", str(tmp_path / "m"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"))
     assert out.returncode == 2 and "Traceback" not in out.stderr and out.stderr.strip().count("\n") == 0
     assert "truncated or corrupt" in out.stderr
 
@@ -340,7 +340,7 @@ def test_first_images_malformed(seq, tmp_path, capsys):
 def test_imu_wait_is_bag_time(seq, tmp_path):
     """A frame waits for the gyro at most imu_wait_ms of bag (log) time: an IMU logged 40 ms after its
     stamp is too late for the default 15 ms (no prior), in time for 100 ms (prior on every frame)."""
-    from iemd_ros.pipeline import PipelineConfig
+    from iemd_ros.pipeline.pipeline import PipelineConfig
 
     t_cam = seq.gyro_t_ns - seq.time_offset_ns
     events = [(int(t) + 40_000_000, 0, i) for i, t in enumerate(t_cam)]

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from iemd_ros.rotation import (GyroCalibration, StillBiasEstimator, integrate_first_order, integrate_rates,
+from iemd_ros.gyro.rotation import (GyroCalibration, StillBiasEstimator, integrate_first_order, integrate_rates,
                                omega_matrix, quat_exp, quat_mul, quat_to_rot, rot_to_quat, rotation_angle,
                                skew, so3_exp)
 

@@ -4,9 +4,9 @@ import pytest
 from helpers import zoomed
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.boxes import box_centre
-from iemd_ros.scale_filter import ScaleFilter
+from iemd_ros.tracking.appearance import ImagePyramid, to_gray
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.scale_filter import ScaleFilter
 
 
 def test_the_scaled_windows_are_the_windows_sampled_one_by_one(car4_first):

@@ -2,8 +2,8 @@
 import numpy as np
 import pytest
 
-from iemd_ros.histogram import candidate_weights, target_weights
-from iemd_ros.sparse_coding import SparseCoder, lasso_objective, max_alignment_pooling
+from iemd_ros.tracking.histogram import candidate_weights, target_weights
+from iemd_ros.tracking.sparse_coding import SparseCoder, lasso_objective, max_alignment_pooling
 
 
 def patch_dictionary(seed=0, dim=64, n_atoms=147, n_signals=40):

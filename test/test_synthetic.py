@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from iemd_ros.gyro import rotation_homography, warp_difference
-from iemd_ros.rotation import so3_exp
-from iemd_ros.synthetic import SyntheticConfig, angular_velocity, generate
+from iemd_ros.gyro.predictor import rotation_homography, warp_difference
+from iemd_ros.gyro.rotation import so3_exp
+from iemd_ros.datasets.synthetic import SyntheticConfig, angular_velocity, generate
 
 
 @pytest.fixture(scope="module")

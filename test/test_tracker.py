@@ -6,12 +6,12 @@ import pytest
 from helpers import rotated, shifted, texture
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import ImagePyramid, PatchLayout, to_gray
-from iemd_ros.boxes import box_centre
-from iemd_ros.metrics import iou
-from iemd_ros.otb import load_sequence, read_frame
-from iemd_ros.template import TemplateDictionary
-from iemd_ros.tracker import MIN_SIDE_PX, _scale_bounds, _visible_fraction
+from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.datasets.otb import load_sequence, read_frame
+from iemd_ros.tracking.template import TemplateDictionary
+from iemd_ros.tracking.tracker import MIN_SIDE_PX, _scale_bounds, _visible_fraction
 
 
 @pytest.mark.parametrize("bad,match", [
@@ -165,7 +165,7 @@ def test_target_leaving_the_image_is_reported_lost():
 
 
 def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
-    import iemd_ros.candidate as candidate
+    import iemd_ros.tracking.candidate as candidate
     solves = []
     solve = candidate.solve_emd
 

@@ -4,10 +4,10 @@ import pytest
 from helpers import shifted
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.appearance import ImagePyramid, to_gray
-from iemd_ros.boxes import box_centre
-from iemd_ros.correlation_filter import CELL
-from iemd_ros.translation_filter import TranslationFilter
+from iemd_ros.tracking.appearance import ImagePyramid, to_gray
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.correlation_filter import CELL
+from iemd_ros.tracking.translation_filter import TranslationFilter
 
 
 def _learned(frame, box, angle=0.0, **kwargs):

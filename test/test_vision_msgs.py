@@ -2,7 +2,7 @@
 
 Checks the message layout, CDR round trips with rclpy, the RIHS01 type hashes against an upstream
 build, publish/subscribe of Detection2DArray between two processes, and rosbags registration of
-the same definitions (iemd_ros.bag_types) with byte-identical CDR.
+the same definitions (iemd_ros.bags.types) with byte-identical CDR.
 
 This file is also the publisher of the two-process test:
 ``python test_vision_msgs.py --publish TOPIC``.
@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from iemd_ros.bag_types import vision_msgs_types
+from iemd_ros.bags.types import vision_msgs_types
 
 # The repository's sources (iemd_ros itself may be installed in the venv, away from the tree).
 REPO_MSG_DIR = Path(__file__).resolve().parents[1] / "interfaces" / "vision_msgs" / "msg"
@@ -196,7 +196,7 @@ def _publisher_main(topic: str) -> int:
     """Publish the sample Detection2DArray on ``topic`` at 20 Hz until SIGINT (or 60 s)."""
     import rclpy
 
-    from iemd_ros.spin import spin_until_shutdown
+    from iemd_ros.ros.spin import spin_until_shutdown
     from vision_msgs.msg import Detection2DArray
 
     rclpy.init()

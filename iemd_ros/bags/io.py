@@ -1,0 +1,314 @@
+"""Bag I/O shared by ``iemd-make-bag``, ``iemd-replay`` and ``iemd-play`` (rosbags, no rclpy).
+
+* Typestores: ROS 2 Jazzy (+ vision_msgs, :mod:`iemd_ros.bags.types`) and ROS 1 Noetic.
+* :class:`BagWriter`: one writer for rosbag2 (mcap or sqlite3) and ROS 1 ``.bag`` files; messages are
+  built with the writer's typestore classes (:meth:`BagWriter.msg`), so ROS 1/2 field differences
+  (``Header.seq``, ``CameraInfo.K`` vs ``k``) are handled by :func:`header` / :func:`camera_info_fields`.
+* :func:`open_bag`: AnyReader over a rosbag2 folder (sqlite3 or mcap, also given as its
+  ``metadata.yaml`` / storage file) or a ROS 1 ``.bag``; every failure becomes a :class:`BagError`
+  (a ``ValueError``) with a readable message, including truncation found while reading
+  (:func:`iter_messages`).
+* :func:`select_topics`: the image / IMU / camera-info topics, auto-detected when a bag has exactly one
+  topic of a type, else named (wrong type or ambiguity -> BagError).  The image topic is a
+  ``sensor_msgs/Image`` or a ``sensor_msgs/CompressedImage`` (image_transport's ``<image>/compressed``);
+  auto-detection takes the one image topic that holds messages, where a compressed topic whose raw
+  twin ``<image>`` holds messages too does not count (the twins carry the same frames, raw is
+  lossless).  Any other mix (e.g. a depth Image beside a colour stream's ``/compressed``) -> BagError
+  naming the candidates.
+"""
+from __future__ import annotations
+
+import shutil
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from iemd_ros.messages.conversions import ns_to_stamp, raw_twin
+from iemd_ros.common.cli import one_line
+
+__all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE",
+           "DIAGNOSTICS_TYPE", "FORMATS",
+           "BagError", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize",
+           "header", "iter_messages", "open_bag", "resolve_bag_path", "ros1_typestore", "ros2_typestore",
+           "select_topics"]
+
+IMAGE_TYPE = "sensor_msgs/msg/Image"
+COMPRESSED_IMAGE_TYPE = "sensor_msgs/msg/CompressedImage"
+#: types an image topic may have
+IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
+IMU_TYPE = "sensor_msgs/msg/Imu"
+CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
+DETECTIONS_TYPE = "vision_msgs/msg/Detection2DArray"
+DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
+#: rosbag2 custom_data keys written by iemd-make-bag (documentation of the bag's provenance).
+META_PREFIX = "iemd_ros."
+
+
+class BagError(ValueError):
+    """A bag that cannot be read, written or used (missing, truncated, wrong topics, ...)."""
+
+
+def ros2_typestore():
+    """ROS 2 Jazzy typestore with the vision_msgs definitions registered."""
+    from rosbags.typesys import Stores, get_typestore
+
+    from iemd_ros.bags.types import vision_msgs_types
+
+    ts = get_typestore(Stores.ROS2_JAZZY)
+    ts.register(vision_msgs_types())
+    return ts
+
+
+def ros1_typestore():
+    """ROS 1 Noetic typestore (Image, Imu, CameraInfo with ``D``/``K``/``R``/``P`` and ``Header.seq``)."""
+    from rosbags.typesys import Stores, get_typestore
+
+    return get_typestore(Stores.ROS1_NOETIC)
+
+
+# ---------------------------------------------------------------------------------------------- writing
+FORMATS = ("mcap", "sqlite3", "ros1")
+
+
+class BagWriter:
+    """Write one bag: ``fmt`` is ``mcap`` / ``sqlite3`` (rosbag2 version 9 folder) or ``ros1`` (.bag file).
+
+    Use as a context manager; on an exception the partial bag is removed.  ``custom_data`` (rosbag2 only) goes into ``metadata.yaml``.
+    """
+
+    def __init__(self, path, fmt: str = "mcap", custom_data: dict | None = None):
+        if fmt not in FORMATS:
+            raise BagError(f"unknown bag format {fmt!r} (choose from {', '.join(FORMATS)})")
+        self.path = Path(path)
+        self.fmt = fmt
+        if self.path.exists():
+            raise BagError(f"output {self.path} exists already; choose a new path")
+        if fmt == "ros1":
+            from rosbags.rosbag1 import Writer
+
+            if self.path.suffix != ".bag":
+                raise BagError(f"a ROS 1 bag must be a file ending in .bag, got {self.path}")
+            self.typestore = ros1_typestore()
+            self._writer = Writer(self.path)
+        else:
+            from rosbags.rosbag2 import StoragePlugin, Writer
+
+            plugin = StoragePlugin.MCAP if fmt == "mcap" else StoragePlugin.SQLITE3
+            self.typestore = ros2_typestore()
+            self._writer = Writer(self.path, version=9, storage_plugin=plugin)
+            for k, v in (custom_data or {}).items():
+                self._writer.set_custom_data(str(k), str(v))
+        self._seq: dict[str, int] = {}
+        self.counts: dict[str, int] = {}
+
+    @property
+    def ros1(self) -> bool:
+        return self.fmt == "ros1"
+
+    def __enter__(self) -> BagWriter:
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._writer.open()
+        self._conns: dict[str, object] = {}
+        return self
+
+    def __exit__(self, exc_type, exc, tb):
+        result = self._writer.__exit__(exc_type, exc, tb)
+        if exc_type is not None:            # do not leave a half-written bag behind
+            if self.path.is_dir():
+                shutil.rmtree(self.path, ignore_errors=True)
+            elif self.path.exists():
+                self.path.unlink()
+        return result
+
+    def msg(self, msgtype: str):
+        """Message class of ``msgtype`` in this bag's typestore."""
+        return self.typestore.types[msgtype]
+
+    def add_topic(self, topic: str, msgtype: str) -> None:
+        self._conns[topic] = self._writer.add_connection(topic, msgtype, typestore=self.typestore)
+        self.counts[topic] = 0
+
+    def next_seq(self, topic: str) -> int:
+        """ROS 1 ``Header.seq`` of the next message on ``topic``."""
+        s = self._seq.get(topic, 0)
+        self._seq[topic] = s + 1
+        return s
+
+    def write(self, topic: str, log_time_ns: int, message) -> None:
+        conn = self._conns[topic]
+        ser = self.typestore.serialize_ros1 if self.ros1 else self.typestore.serialize_cdr
+        self._writer.write(conn, int(log_time_ns), ser(message, conn.msgtype))
+        self.counts[topic] += 1
+
+
+def header(bag: BagWriter, topic: str, stamp_ns: int, frame_id: str):
+    """``std_msgs/Header`` with ``stamp_ns`` (ROS 1: plus the per-topic ``seq``)."""
+    sec, nsec = ns_to_stamp(stamp_ns)
+    stamp = bag.msg("builtin_interfaces/msg/Time")(sec=sec, nanosec=nsec)
+    if bag.ros1:
+        return bag.msg("std_msgs/msg/Header")(seq=bag.next_seq(topic), stamp=stamp, frame_id=frame_id)
+    return bag.msg("std_msgs/msg/Header")(stamp=stamp, frame_id=frame_id)
+
+
+def camera_info_fields(ros1: bool, d, k, r, p) -> dict:
+    """CameraInfo matrix fields under their ROS 1 (``D K R P``) or ROS 2 (``d k r p``) names."""
+    names = ("D", "K", "R", "P") if ros1 else ("d", "k", "r", "p")
+    return dict(zip(names, (np.asarray(v, dtype=np.float64).ravel() for v in (d, k, r, p))))
+
+
+# ---------------------------------------------------------------------------------------------- reading
+def resolve_bag_path(path) -> Path:
+    """The path AnyReader takes: a ``.bag`` file or a rosbag2 folder (also from its metadata/storage file)."""
+    p = Path(path)
+    if not p.exists():
+        raise BagError(f"bag {p} does not exist")
+    if p.is_file() and p.suffix != ".bag":
+        if p.name == "metadata.yaml" or p.suffix in (".mcap", ".db3"):
+            p = p.parent
+        else:
+            raise BagError(f"{p} is neither a ROS 1 .bag file nor a rosbag2 folder")
+    if p.is_dir() and not (p / "metadata.yaml").is_file():
+        raise BagError(f"{p} is not a rosbag2 folder: it has no metadata.yaml")
+    return p
+
+
+def _reader_errors() -> tuple:
+    import sqlite3
+    import struct
+    import zlib
+
+    from rosbags.highlevel import AnyReaderError
+    from rosbags.rosbag1 import ReaderError as Reader1Error
+    from rosbags.rosbag2 import ReaderError as Reader2Error
+    from rosbags.serde import SerdeError
+    from rosbags.typesys import TypesysError
+
+    return (AnyReaderError, Reader1Error, Reader2Error, SerdeError, TypesysError, sqlite3.Error,
+            struct.error, zlib.error, EOFError, OSError, KeyError, IndexError, ValueError, AssertionError)
+
+
+def open_bag(path):
+    """Open a bag with rosbags' AnyReader; returns the open reader (close it, or use ``with``)."""
+    from rosbags.highlevel import AnyReader
+
+    p = resolve_bag_path(path)
+    try:
+        reader = AnyReader([p], default_typestore=ros2_typestore())
+        reader.open()
+    except _reader_errors() as exc:
+        raise BagError(f"cannot read bag {p} (missing, truncated or corrupt?): {one_line(exc)}") from None
+    return reader
+
+
+def iter_messages(reader, connections, path="bag") -> Iterator[tuple[object, int, bytes]]:
+    """``reader.messages(connections)``; a read error (truncated/corrupt storage) becomes a BagError."""
+    it = reader.messages(connections=connections)
+    while True:
+        try:
+            item = next(it)
+        except StopIteration:
+            return
+        except _reader_errors() as exc:
+            raise BagError(f"bag {path} is truncated or corrupt: {one_line(exc)}") from None
+        yield item
+
+
+def deserialize(reader, raw: bytes, msgtype: str, path="bag"):
+    try:
+        return reader.deserialize(raw, msgtype)
+    except _reader_errors() as exc:
+        raise BagError(f"bag {path}: cannot decode a {msgtype} message: {one_line(exc)}") from None
+
+
+@dataclass(frozen=True)
+class Topics:
+    """Topics chosen for replay; ``imu``/``camera_info`` are None when the bag has none."""
+
+    image: str
+    imu: str | None
+    camera_info: str | None
+
+
+def _listing(topics: dict, names) -> str:
+    return ", ".join(f"{t} [{topics[t].msgtype}]" for t in sorted(names)) or "none"
+
+
+def _pick(topics: dict, msgtypes: tuple[str, ...], wanted: str | None, role: str, required: bool,
+          narrow=lambda topics, names: names) -> str | None:
+    """The ``role`` topic: ``wanted`` if given (of one of ``msgtypes``), else the one topic of those types
+    that ``narrow(topics, names)`` keeps; None (or BagError if ``required``) when the bag has none."""
+    expected = " or ".join(msgtypes)
+    if wanted is not None:
+        if wanted not in topics:
+            raise BagError(f"{role} topic {wanted!r} is not in the bag (topics: {', '.join(sorted(topics)) or 'none'})")
+        if topics[wanted].msgtype not in msgtypes:
+            raise BagError(f"{role} topic {wanted!r} has type {topics[wanted].msgtype}, expected {expected}")
+        return wanted
+    of_type = [t for t, info in topics.items() if info.msgtype in msgtypes]
+    if not of_type:
+        if required:
+            raise BagError(f"the bag has no {expected} topic (topics: {_listing(topics, topics)})")
+        return None
+    candidates = narrow(topics, of_type)
+    if len(candidates) > 1:
+        flag = {"image": "--image-topic", "IMU": "--imu-topic", "camera-info": "--camera-info-topic"}[role]
+        raise BagError(f"the bag has {len(candidates)} {role} topics ({_listing(topics, candidates)}); "
+                       f"choose one with {flag}")
+    return candidates[0]
+
+
+def _image_candidates(topics: dict, images: list[str]) -> list[str]:
+    """The image topics auto-detection may take: those holding messages (all of them if none does),
+    without a compressed topic whose raw twin holds messages (module docstring)."""
+    filled = [t for t in images if topics[t].msgcount > 0] or images
+    raw = {t for t in filled if topics[t].msgtype == IMAGE_TYPE}
+    return [t for t in filled if not (topics[t].msgtype == COMPRESSED_IMAGE_TYPE and raw_twin(t) in raw)]
+
+
+def select_topics(reader, image: str | None = None, imu: str | None = None,
+                  camera_info: str | None = None) -> Topics:
+    """Choose the image, IMU and camera-info topics of an open reader (see module docstring)."""
+    topics = reader.topics
+    img = _pick(topics, IMAGE_TYPES, image, "image", True, narrow=_image_candidates)
+    if topics[img].msgcount == 0:
+        raise BagError(f"image topic {img!r} holds no message")
+    return Topics(img, _pick(topics, (IMU_TYPE,), imu, "IMU", False),
+                  _pick(topics, (CAMERA_INFO_TYPE,), camera_info, "camera-info", False))
+
+
+def custom_data(reader) -> dict:
+    """rosbag2 ``custom_data`` of an open reader ({} for ROS 1 bags)."""
+    out: dict = {}
+    for r in getattr(reader, "readers", []):
+        md = getattr(getattr(r, "storage", None), "metadata", None)
+        out.update(getattr(md, "custom", None) or {})
+    return out
+
+
+class Progress:
+    """A one-line progress bar on stderr (only when stderr is a terminal; ``enabled`` overrides)."""
+
+    def __init__(self, total: int, label: str = "", enabled: bool | None = None, stream=None):
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = (self.stream.isatty() if enabled is None else enabled) and total > 0
+        self.total, self.label, self.n, self._last = int(total), label, 0, -1
+
+    def update(self, n: int = 1, note: str = "") -> None:
+        self.n += n
+        if not self.enabled:
+            return
+        pct = int(100 * self.n / self.total)
+        if pct == self._last and self.n < self.total:
+            return
+        self._last = pct
+        filled = int(30 * self.n / self.total)
+        self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (30 - filled)}] {self.n}/{self.total} {note}")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            self.stream.write("\n")
+            self.stream.flush()

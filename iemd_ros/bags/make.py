@@ -1,0 +1,414 @@
+"""``iemd-make-bag``: image folder + gyro log + calibration -> rosbag2 (mcap/sqlite3) or ROS 1 ``.bag``.
+
+Sources (detected from the folder; loaded by :mod:`iemd_ros.datasets.recordings` / :mod:`iemd_ros.datasets.otb`):
+
+* CMU desk / aerial (``*_img.log``) and the phone sequence (``derived_gyro_camframe.csv``): frames,
+  gyro, calibration and time offset of the recording;
+* an OTB sequence (``img/`` + ``groundtruth_rect.txt``): frames only, stamped at ``--fps``; no IMU and
+  no camera info (OTB has no calibration) unless ``--camera-yaml`` is given;
+* any folder of images (sorted by name) with ``--fps`` or ``--stamps FILE`` (one time in seconds per
+  line), optionally ``--imu-csv FILE`` (``t_s, wx, wy, wz[, ax, ay, az]``, rad/s, m/s^2) and
+  ``--camera-yaml FILE`` (ROS camera_info YAML).
+
+Images are ``sensor_msgs/Image`` (``--encoding`` bgr8 or mono8) on ``--image-topic``, or with
+``--compress jpeg|png`` ``sensor_msgs/CompressedImage`` as image_transport's compressed plugin writes
+them: on ``--image-topic`` + ``/compressed``, format ``"bgr8; jpeg compressed bgr8"`` (mono8:
+``"mono8; png compressed "``), JPEG quality ``--jpeg-quality`` (default 95); PNG is lossless.
+
+Stamps and clocks (the choice made here)
+----------------------------------------
+All header stamps are on the **camera clock**: ``Image.header.stamp = CameraInfo.header.stamp`` = the
+frame's capture time, and the IMU samples are shifted onto the camera clock with the recording's
+offset (Kalibr's ``t_imu = t_cam + t_d``): ``Imu.header.stamp = t_imu - t_d`` (CMU: t_d = -20 ms, so
++20 ms; phone: t_d = +13 ms).  A bag made here therefore needs ``t_d = 0`` at replay time, which is
+the replay's and the node's default; the applied shift is recorded in the rosbag2 ``custom_data``
+(``iemd_ros.imu_time_shift_ns``) for provenance only.  Shifting rather than keeping the IMU clock
+makes the bag self-consistent for any consumer (Foxglove, ``ros2 bag play`` into other nodes) and
+survives ``rosbags-convert`` from ROS 1, which has no metadata to carry an offset.
+
+IMU samples within ``--imu-margin`` of the first/last frame are kept, in the recorded row order
+(the desk clock steps back at 3 rows: those samples keep their stamps, the consumer's buffer sorts them).
+
+Frames: ``Imu.angular_velocity`` is the gyro rate as the loader gives it.  The CMU and phone loaders give
+the *derived camera-frame* rate (SOURCES.md), so their IMU ``frame_id`` is the camera's optical frame
+(identity extrinsic by construction); a user's ``--imu-csv`` is written with ``--imu-frame-id``
+(default ``imu_link``) and its extrinsic must be configured in the consumer.  ``orientation_covariance[0]
+= -1`` (no orientation); ``linear_acceleration_covariance[0] = -1`` when there is no accelerometer.
+
+Log (receive) times: images and camera info are logged at their stamp, IMU samples at the running
+maximum of their stamps (a sample is never received before an earlier-logged one); all log times are
+then made strictly increasing (+1 ns steps where equal, order IMU, camera info, image), so every reader
+sees the same, unambiguous message order.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from dataclasses import dataclass
+from collections.abc import Callable
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from iemd_ros.bags.io import (CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX,
+                     BagWriter, Progress, camera_info_fields, header)
+from iemd_ros.gyro.camera import CameraModel
+from iemd_ros.common.cli import CliParser, cli_main
+from iemd_ros.messages.conversions import (COMPRESSED_CODECS, JPEG_QUALITY, array_to_compressed_fields, check_compression,
+                          compressed_topic, is_compressed_topic)
+from iemd_ros.datasets.otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
+from iemd_ros.datasets.recordings import seconds_to_ns, load_recording
+
+__all__ = ["BagSource", "source_from_folder", "source_from_synthetic", "write_bag", "main",
+           "DEFAULT_TOPICS", "ENCODINGS"]
+
+DEFAULT_TOPICS = dict(image="/camera/image_raw", camera_info="/camera/camera_info", imu="/imu/data")
+CAMERA_FRAME = "camera_optical_frame"
+IMU_FRAME = "imu_link"
+ENCODINGS = ("bgr8", "mono8")
+_BASE_NS = 1_000_000_000   # stamps of frame-rate-only sources start at 1 s (0 often means "unset")
+
+
+@dataclass
+class BagSource:
+    """What goes into a bag.  Stamps are integer ns; ``imu_t_ns`` is on the IMU clock.
+
+    ``read_frame(i, grey)`` returns frame ``i`` as BGR (or grey) uint8.  ``time_offset_ns`` is t_d
+    (``t_imu = t_cam + t_d``).  ``imu_frame_id`` None: the gyro is in the camera frame.
+    """
+
+    name: str
+    frame_stamps_ns: np.ndarray
+    read_frame: Callable[[int, bool], np.ndarray]
+    camera: CameraModel | None = None
+    imu_t_ns: np.ndarray | None = None
+    gyro: np.ndarray | None = None
+    accel: np.ndarray | None = None
+    time_offset_ns: int = 0
+    imu_frame_id: str | None = None
+    gt_boxes: np.ndarray | None = None      # (N, 4) 0-based
+    gt_flags: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.frame_stamps_ns)
+
+    @property
+    def has_imu(self) -> bool:
+        return self.imu_t_ns is not None and len(self.imu_t_ns) > 0
+
+
+def _frame_rate_stamps(n: int, fps: float) -> np.ndarray:
+    if not fps > 0:
+        raise ValueError(f"--fps must be > 0, got {fps}")
+    return _BASE_NS + np.round(np.arange(n) * 1e9 / fps).astype(np.int64)
+
+
+def _read_table(path: Path, min_cols: int, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of a CSV/whitespace file (``#`` comments and a non-numeric header skipped): the first
+    column as exact integer ns (decimal seconds, :func:`iemd_ros.datasets.recordings.seconds_to_ns`) and the other
+    columns (up to 6) as floats."""
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"cannot read {what} {path}: {exc}") from None
+    times, values = [], []
+    for n, line in enumerate(text.splitlines(), 1):
+        parts = line.split("#", 1)[0].replace(",", " ").split()
+        if not parts:
+            continue
+        try:
+            vals = [float(p) for p in parts]
+        except ValueError:
+            if not times:
+                continue            # header line
+            raise ValueError(f"{path}:{n}: not a number in {what} line {line!r}") from None
+        if len(vals) < min_cols or not all(np.isfinite(vals[:1])):
+            raise ValueError(f"{path}:{n}: {what} needs at least {min_cols} columns, got {line!r}")
+        times.append(seconds_to_ns(parts[0]))
+        values.append(vals[1:7])
+    if not times:
+        raise ValueError(f"{path}: no {what} rows")
+    width = min(len(v) for v in values)
+    return np.array(times, dtype=np.int64), np.array([v[:width] for v in values], dtype=float).reshape(len(times), width)
+
+
+def source_from_folder(folder, fps: float | None = None, stamps=None, imu_csv=None, camera_yaml=None,
+                       time_offset_ms: float | None = None, imu_frame_id: str = IMU_FRAME) -> BagSource:
+    """Detect and load a source folder (see module docstring)."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise ValueError(f"source {folder} is not a folder")
+    camera = CameraModel.from_yaml(camera_yaml) if camera_yaml else None
+    if list(folder.glob("*_img.log")) or (folder / "derived_gyro_camframe.csv").exists():
+        if fps or stamps or imu_csv or time_offset_ms is not None:
+            raise ValueError(f"{folder} is a known recording: --fps/--stamps/--imu-csv/--time-offset-ms "
+                             "do not apply (its own stamps, gyro and offset are used)")
+        rec = load_recording(folder)
+        return BagSource(rec.name, rec.frame_stamps_ns, rec.load_frame, camera or rec.camera, rec.imu_t_ns,
+                         rec.gyro, rec.accel, rec.time_offset_ns, None, rec.gt_boxes, rec.gt_flags)
+    if is_sequence_folder(folder):
+        names = list_sequences(folder.parent)
+        name = next(n for n in names if n == folder.name or n.startswith(folder.name + "-"))
+        seq = load_sequence(name, folder.parent)
+        paths = list(seq.frame_paths)
+        gt = seq.gt_boxes
+    else:
+        paths = sorted(p for p in folder.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES)
+        if not paths:
+            raise ValueError(f"{folder} holds no image (.jpg/.jpeg/.png) and is no known recording layout")
+        name, gt = folder.name, None
+    if stamps:
+        t = _read_table(Path(stamps), 1, "frame stamp")[0]
+        if len(t) != len(paths):
+            raise ValueError(f"{stamps} has {len(t)} stamps for {len(paths)} images in {folder}")
+    else:
+        t = _frame_rate_stamps(len(paths), fps if fps is not None else 30.0)
+    if np.any(np.diff(t) <= 0):
+        raise ValueError("frame stamps must increase strictly")
+    imu_t = gyro = accel = None
+    if imu_csv:
+        imu_t, rows = _read_table(Path(imu_csv), 4, "IMU")
+        gyro = rows[:, 0:3]
+        accel = rows[:, 3:6] if rows.shape[1] >= 6 else None
+
+    def load(i: int, grey: bool = False) -> np.ndarray:
+        img = read_frame(paths[i])
+        return cv2.cvtColor(img, cv2.COLOR_BGR2GRAY) if grey else img
+
+    offset = int(round((time_offset_ms or 0.0) * 1e6))
+    return BagSource(name, t, load, camera, imu_t, gyro, accel, offset, imu_frame_id if imu_csv else None, gt)
+
+
+def source_from_synthetic(seq, imu_frame_id: str = IMU_FRAME) -> BagSource:
+    """A :class:`~iemd_ros.datasets.synthetic.SyntheticSequence` (rendered) as a bag source (gyro in the IMU
+    frame, ``R_cam_imu`` of the sequence; identity by default)."""
+    if seq.frames is None:
+        raise ValueError("the synthetic sequence was generated with render=False: no frames to write")
+
+    def load(i: int, grey: bool = False) -> np.ndarray:
+        f = seq.frames[i]
+        return cv2.cvtColor(f, cv2.COLOR_BGR2GRAY) if grey else f
+
+    imu_frame = None if np.allclose(seq.R_cam_imu, np.eye(3)) else imu_frame_id
+    return BagSource("synthetic", seq.frame_stamps_ns, load, seq.camera, seq.gyro_t_ns, seq.gyro, None,
+                     seq.time_offset_ns, imu_frame, seq.gt_boxes)
+
+
+# ---------------------------------------------------------------------------------------------- writing
+def _image_msg(bag: BagWriter, topic: str, t: int, frame_id: str, img: np.ndarray, encoding: str):
+    img = np.ascontiguousarray(img)
+    h, w = img.shape[:2]
+    ch = 1 if img.ndim == 2 else img.shape[2]
+    return bag.msg(IMAGE_TYPE)(header=header(bag, topic, t, frame_id), height=h, width=w, encoding=encoding,
+                               is_bigendian=0, step=w * ch, data=img.reshape(-1))
+
+
+def _compressed_msg(bag: BagWriter, topic: str, t: int, frame_id: str, img: np.ndarray, codec: str,
+                    jpeg_quality: int = JPEG_QUALITY):
+    """``img`` (bgr8 or mono8) as image_transport's compressed plugin publishes it
+    (:func:`iemd_ros.messages.conversions.array_to_compressed_fields`)."""
+    fields = array_to_compressed_fields(img, codec, jpeg_quality)
+    return bag.msg(COMPRESSED_IMAGE_TYPE)(header=header(bag, topic, t, frame_id), format=fields["format"],
+                                          data=np.frombuffer(fields["data"], dtype=np.uint8))
+
+
+def _camera_info_msg(bag: BagWriter, topic: str, t: int, frame_id: str, camera: CameraModel, w: int, h: int):
+    info = camera.to_camera_info()
+    roi = bag.msg("sensor_msgs/msg/RegionOfInterest")(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)
+    return bag.msg(CAMERA_INFO_TYPE)(
+        header=header(bag, topic, t, frame_id), height=h, width=w, distortion_model="plumb_bob",
+        **camera_info_fields(bag.ros1, info["distortion_coefficients"]["data"], info["camera_matrix"]["data"],
+                             info["rectification_matrix"]["data"], info["projection_matrix"]["data"]),
+        binning_x=0, binning_y=0, roi=roi)
+
+
+def _imu_msg(bag: BagWriter, topic: str, t: int, frame_id: str, w: np.ndarray, a: np.ndarray | None):
+    V = bag.msg("geometry_msgs/msg/Vector3")
+    no_cov = np.zeros(9)
+    unknown = np.zeros(9)
+    unknown[0] = -1.0
+    return bag.msg(IMU_TYPE)(
+        header=header(bag, topic, t, frame_id),
+        orientation=bag.msg("geometry_msgs/msg/Quaternion")(x=0.0, y=0.0, z=0.0, w=1.0),
+        orientation_covariance=unknown.copy(),
+        angular_velocity=V(x=float(w[0]), y=float(w[1]), z=float(w[2])), angular_velocity_covariance=no_cov.copy(),
+        linear_acceleration=V(x=0.0, y=0.0, z=0.0) if a is None else V(x=float(a[0]), y=float(a[1]), z=float(a[2])),
+        linear_acceleration_covariance=unknown.copy() if a is None else no_cov.copy())
+
+
+def _schedule(frame_t: np.ndarray, imu_t: np.ndarray | None, with_info: bool) -> list[tuple[int, int, int]]:
+    """``(log_time_ns, kind, index)`` in writing order; kind 0 = IMU, 1 = camera info, 2 = image."""
+    events = []
+    if imu_t is not None and len(imu_t):
+        recv = np.maximum.accumulate(imu_t)
+        events += [(int(t), 0, i) for i, t in enumerate(recv)]
+    for i, t in enumerate(frame_t):
+        if with_info:
+            events.append((int(t), 1, i))
+        events.append((int(t), 2, i))
+    events.sort()
+    out, last = [], None
+    for t, kind, i in events:
+        t = t if last is None or t > last else last + 1
+        out.append((t, kind, i))
+        last = t
+    return out
+
+
+def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8", first: int = 0,
+              count: int | None = None, imu_margin_s: float = 0.5, topics: dict | None = None,
+              frame_id: str = CAMERA_FRAME, gt_out=None, progress: Callable[[int], None] | None = None,
+              compress: str | None = None, jpeg_quality: int | None = None) -> dict:
+    """Write frames ``first .. first+count-1`` of ``source`` (with camera info and the IMU samples
+    within ``imu_margin_s`` of them) into a new bag ``out``.  Returns a summary dict (message counts,
+    the image topic, the IMU shift applied, the frame range).  ``gt_out``: also write the frames' ground
+    truth there (OTB text, 1-based; the desk flags kept as a 5th column).  ``compress`` ``"jpeg"`` /
+    ``"png"``: CompressedImage on the image topic + ``/compressed`` (module docstring)."""
+    if encoding not in ENCODINGS:
+        raise ValueError(f"encoding must be one of {', '.join(ENCODINGS)}, got {encoding!r}")
+    if jpeg_quality is not None and compress != "jpeg":
+        raise ValueError(f"--jpeg-quality applies to --compress jpeg only (got --compress {compress or 'off'})")
+    quality = JPEG_QUALITY if jpeg_quality is None else jpeg_quality
+    if compress is not None:
+        check_compression(compress, quality)  # before the bag is opened
+    n = len(source)
+    if not 0 <= first < n:
+        raise ValueError(f"--first {first} is outside the {n} frames of {source.name}")
+    last = n if count is None else first + int(count)
+    if count is not None and (count < 1 or last > n):
+        raise ValueError(f"--count {count} from frame {first} exceeds the {n} frames of {source.name}")
+    if imu_margin_s < 0:
+        raise ValueError(f"--imu-margin must be >= 0 s, got {imu_margin_s}")
+    if gt_out is not None and source.gt_boxes is None:
+        raise ValueError(f"{source.name} has no ground truth to write to {gt_out}")
+    tp = dict(DEFAULT_TOPICS, **(topics or {}))
+    if compress is not None:
+        if is_compressed_topic(tp["image"]):
+            raise ValueError(f"--image-topic {tp['image']} ends in /compressed: give the raw topic, --compress "
+                             "appends /compressed as image_transport does")
+        tp["image"] = compressed_topic(tp["image"])
+    frame_t = np.asarray(source.frame_stamps_ns[first:last], dtype=np.int64)
+    shift = -int(source.time_offset_ns)                    # IMU clock -> camera clock
+    imu_idx = imu_t = None
+    if source.has_imu:
+        t_cam = np.asarray(source.imu_t_ns, dtype=np.int64) + shift
+        margin = int(round(imu_margin_s * 1e9))
+        imu_idx = np.nonzero((t_cam >= frame_t[0] - margin) & (t_cam <= frame_t[-1] + margin))[0]
+        if len(imu_idx) == 0:
+            raise ValueError(f"{source.name}: no IMU sample within {imu_margin_s} s of the frames")
+        imu_t = t_cam[imu_idx]
+    first_img = source.read_frame(first, encoding == "mono8")
+    h, w = first_img.shape[:2]
+    if source.camera is not None and source.camera.width is not None \
+            and (source.camera.width, source.camera.height) != (w, h):
+        raise ValueError(f"calibration is for {source.camera.width}x{source.camera.height} but the images "
+                         f"are {w}x{h}")
+    meta = {f"{META_PREFIX}source": source.name, f"{META_PREFIX}frames": f"{first}:{last}",
+            f"{META_PREFIX}imu_time_shift_ns": str(shift if source.has_imu else 0),
+            f"{META_PREFIX}stamps": "header stamps on the camera clock; IMU already shifted (replay t_d = 0)"}
+    imu_frame = source.imu_frame_id or frame_id
+    with BagWriter(out, fmt, meta) as bag:
+        bag.add_topic(tp["image"], IMAGE_TYPE if compress is None else COMPRESSED_IMAGE_TYPE)
+        if source.camera is not None:
+            bag.add_topic(tp["camera_info"], CAMERA_INFO_TYPE)
+        if imu_t is not None:
+            bag.add_topic(tp["imu"], IMU_TYPE)
+        for log_t, kind, i in _schedule(frame_t, imu_t, source.camera is not None):
+            if kind == 0:
+                j = imu_idx[i]
+                acc = None if source.accel is None else source.accel[j]
+                bag.write(tp["imu"], log_t, _imu_msg(bag, tp["imu"], int(imu_t[i]), imu_frame, source.gyro[j], acc))
+            elif kind == 1:
+                bag.write(tp["camera_info"], log_t,
+                          _camera_info_msg(bag, tp["camera_info"], int(frame_t[i]), frame_id, source.camera, w, h))
+            else:
+                img = first_img if i == 0 else source.read_frame(first + i, encoding == "mono8")
+                if img.shape[:2] != (h, w):
+                    raise ValueError(f"frame {first + i} is {img.shape[1]}x{img.shape[0]}, the first one {w}x{h}")
+                args = (bag, tp["image"], int(frame_t[i]), frame_id, img)
+                bag.write(tp["image"], log_t, _image_msg(*args, encoding) if compress is None
+                          else _compressed_msg(*args, compress, quality))
+                if progress is not None:
+                    progress(1)
+    if gt_out is not None:
+        write_gt(gt_out, source.gt_boxes[first:last],
+                 None if source.gt_flags is None else source.gt_flags[first:last])
+    return dict(path=str(out), format=fmt, frames=last - first, first=first, size=(w, h), image_topic=tp["image"],
+                imu=0 if imu_t is None else len(imu_t), camera_info=source.camera is not None,
+                imu_time_shift_ns=shift if imu_t is not None else 0, counts=dict(bag.counts))
+
+
+def write_gt(path, boxes: np.ndarray, flags=None) -> None:
+    """Ground truth as 1-based ``x,y,w,h`` lines (``NaN`` where absent; the flag as a 5th column if given),
+    readable by :func:`iemd_ros.datasets.otb.parse_groundtruth` (``with_flags=True`` for the 5th column)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with path.open("w", newline="") as f:
+        wr = csv.writer(f, lineterminator="\n")
+        for k, b in enumerate(np.asarray(boxes, dtype=float)):
+            row = [repr(float(v)) for v in (b[0] + 1, b[1] + 1, b[2], b[3])] if np.all(np.isfinite(b)) else ["NaN"] * 4
+            wr.writerow(row + ([str(flags[k])] if flags is not None else []))
+
+
+# ---------------------------------------------------------------------------------------------- CLI
+def build_parser() -> argparse.ArgumentParser:
+    p = CliParser(prog="iemd-make-bag", description=__doc__.split("\n\n")[0],
+                  epilog="Stamps, clocks and frames: see `python -m pydoc iemd_ros.bags.make`.")
+    p.add_argument("source", type=Path, help="recording folder (CMU desk/aerial, phone), OTB sequence folder "
+                                             "or image folder")
+    p.add_argument("out", type=Path, help="output: rosbag2 folder (mcap/sqlite3) or FILE.bag (--format ros1)")
+    p.add_argument("--format", choices=FORMATS, default="mcap", help="bag format (default mcap)")
+    p.add_argument("--encoding", choices=ENCODINGS, default="bgr8", help="Image encoding (default bgr8)")
+    p.add_argument("--compress", choices=COMPRESSED_CODECS, default=None,
+                   help="write sensor_msgs/CompressedImage (image_transport format) on IMAGE_TOPIC/compressed "
+                        "instead of raw Image (default: raw)")
+    p.add_argument("--jpeg-quality", type=int, default=None, metavar="Q",
+                   help=f"JPEG quality 1..100 for --compress jpeg (default {JPEG_QUALITY})")
+    p.add_argument("--first", type=int, default=0, help="first frame (0-based, default 0)")
+    p.add_argument("--count", type=int, default=None, help="number of frames (default: to the end)")
+    p.add_argument("--imu-margin", type=float, default=0.5, metavar="S",
+                   help="keep IMU samples this many seconds around the frames (default 0.5)")
+    p.add_argument("--fps", type=float, default=None, help="frame rate for sources without stamps (default 30)")
+    p.add_argument("--stamps", type=Path, default=None, help="image folder: frame times in seconds, one per line")
+    p.add_argument("--imu-csv", type=Path, default=None, help="image folder: gyro log t_s,wx,wy,wz[,ax,ay,az]")
+    p.add_argument("--camera-yaml", type=Path, default=None, help="ROS camera_info YAML (overrides the source's)")
+    p.add_argument("--time-offset-ms", type=float, default=None,
+                   help="image folder: t_imu = t_cam + offset (Kalibr); the IMU stamps are shifted by -offset")
+    p.add_argument("--image-topic", default=DEFAULT_TOPICS["image"])
+    p.add_argument("--camera-info-topic", default=DEFAULT_TOPICS["camera_info"])
+    p.add_argument("--imu-topic", default=DEFAULT_TOPICS["imu"])
+    p.add_argument("--frame-id", default=CAMERA_FRAME, help=f"camera frame_id (default {CAMERA_FRAME})")
+    p.add_argument("--imu-frame-id", default=IMU_FRAME,
+                   help=f"IMU frame_id for --imu-csv (default {IMU_FRAME}); recordings with a camera-frame "
+                        "gyro use the camera frame_id")
+    p.add_argument("--gt-out", type=Path, default=None, help="also write the frames' ground truth (OTB text)")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    def body() -> int:
+        a = build_parser().parse_args(argv)
+        src = source_from_folder(a.source, a.fps, a.stamps, a.imu_csv, a.camera_yaml, a.time_offset_ms,
+                                 a.imu_frame_id)
+        n = (len(src) - a.first) if a.count is None else a.count
+        bar = Progress(max(n, 0), "iemd-make-bag")
+        try:
+            info = write_bag(src, a.out, a.format, a.encoding, a.first, a.count, a.imu_margin,
+                             dict(image=a.image_topic, camera_info=a.camera_info_topic, imu=a.imu_topic),
+                             a.frame_id, a.gt_out, bar.update, a.compress, a.jpeg_quality)
+        finally:
+            bar.close()
+        print(f"iemd-make-bag: wrote {info['path']} ({info['format']}): {info['frames']} images "
+              f"{info['size'][0]}x{info['size'][1]} {a.encoding}{f' {a.compress}' if a.compress else ''} on "
+              f"{info['image_topic']}, {info['imu']} IMU samples "
+              f"(shifted {info['imu_time_shift_ns'] / 1e6:+.1f} ms onto the camera clock), camera info "
+              f"{'yes' if info['camera_info'] else 'no'}" + (f"; ground truth -> {a.gt_out}" if a.gt_out else ""))
+        return 0
+
+    return cli_main("iemd-make-bag", body)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

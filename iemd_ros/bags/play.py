@@ -1,0 +1,204 @@
+"""``iemd-play``: publish a bag onto ROS 2 topics with its original timing, like ``ros2 bag play``.
+
+    iemd-play BAG [--rate R] [--topics T ...] [--remap FROM:=TO ...] [--delay S] [--wait-subscribers S] [--clock]
+              [--ros-args ...]
+
+rosbag2's player is not installable from PyPI, so this is a small one in rclpy: each message is
+published when ``(log_time - first_log_time) / rate`` of wall time has passed since the start (log time
+= the bag's receive timestamp, which orders the messages), so a running node sees the messages as on
+the robot.  Messages are not copied field by field: the CDR bytes of the bag (for a ROS 1 bag: converted
+to ROS 2 Jazzy CDR by rosbags' own converter) are turned into the rclpy message class with
+``rclpy.serialization.deserialize_message``.  Publishers are reliable / volatile with a queue of
+``--qos-depth`` (a reliable publisher also serves best-effort subscribers, e.g. ``sensor_data``).
+
+``--wait-subscribers S``: wait up to S seconds (wall) until every publisher has a subscriber before
+starting (discovery takes a moment); ``--clock``: also publish ``/clock`` (rosgraph_msgs/Clock) with the
+log time of each message, for nodes with ``use_sim_time``.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from iemd_ros.bags.io import BagError, Progress, iter_messages, open_bag, ros2_typestore
+from iemd_ros.common.cli import CliParser, cli_main, split_ros_args
+from iemd_ros.messages.conversions import ns_to_stamp
+
+
+@dataclass
+class PlayStats:
+    """What :func:`play` did: messages per topic, wall time, and how late messages went out."""
+
+    published: dict = field(default_factory=dict)
+    wall_s: float = 0.0
+    bag_s: float = 0.0
+    max_late_ms: float = 0.0
+    mean_late_ms: float = 0.0
+
+
+def message_class(msgtype: str):
+    """rclpy message class of ``pkg/msg/Name`` (from the installed message package)."""
+    pkg, kind, name = msgtype.split("/")
+    try:
+        return getattr(importlib.import_module(f"{pkg}.{kind}"), name)
+    except (ImportError, AttributeError):
+        raise BagError(f"message type {msgtype} is not installed for rclpy (package {pkg})") from None
+
+
+def _cdr_converter(reader, msgtype: str, cache: dict, dst_typestore):
+    """bytes of the bag -> ROS 2 CDR bytes (identity for rosbag2, rosbags' converter for ROS 1)."""
+    if reader.is2:
+        return bytes
+    from rosbags.convert.converter import generate_message_converter
+
+    conv = generate_message_converter(reader.typestore, dst_typestore, msgtype, msgtype, cache,
+                                      src_is2=False, dst_is2=True)
+    return lambda raw: bytes(conv(raw))
+
+
+def _parse_remaps(remaps) -> dict:
+    out = {}
+    for r in remaps or []:
+        src, sep, dst = r.partition(":=")
+        if not sep or not src or not dst:
+            raise ValueError(f"--remap must be FROM:=TO, got {r!r}")
+        out[src] = dst
+    return out
+
+
+def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s: float = 0.0,
+         wait_subscribers_s: float = 0.0, clock: bool = False, qos_depth: int = 100, node=None,
+         progress: bool | None = False, ros_args: list[str] | None = None) -> PlayStats:
+    """Publish ``bag`` with its timing scaled by ``1/rate``.
+
+    ``topics``: only these bag topics (default all); ``remap``: bag topic -> published topic.
+    ``node``: an rclpy node to create the publishers on (default: a new ``iemd_play`` node; rclpy is
+    initialised if needed, with ``ros_args`` (``["--ros-args", ...]``), and shut down again).
+    """
+    import rclpy
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+    from rclpy.serialization import deserialize_message
+
+    if not rate > 0:
+        raise ValueError(f"--rate must be > 0, got {rate}")
+    if qos_depth < 1:
+        raise ValueError(f"--qos-depth must be >= 1, got {qos_depth}")
+    remap = dict(remap or {})
+    reader = open_bag(bag)
+    own_init = own_node = False
+    stats = PlayStats()
+    pubs: dict = {}
+    clock_pub = None
+    try:
+        available = reader.topics
+        wanted = list(available) if not topics else list(topics)
+        missing = [t for t in wanted if t not in available]
+        if missing:
+            raise BagError(f"topic(s) {', '.join(missing)} not in the bag (topics: {', '.join(sorted(available))})")
+        unknown = [t for t in remap if t not in wanted]
+        if unknown:
+            raise BagError(f"--remap of topic(s) not played: {', '.join(unknown)}")
+        conns = [c for c in reader.connections if c.topic in wanted]
+        total = sum(available[t].msgcount for t in wanted)
+        if not conns or total == 0:
+            raise BagError(f"bag {bag} has no message to play")
+        classes = {c.msgtype: message_class(c.msgtype) for c in conns}
+        if node is None:
+            if not rclpy.ok():
+                rclpy.init(args=["iemd-play", *(ros_args or [])])
+                own_init = True
+            node = rclpy.create_node("iemd_play")
+            own_node = True
+        qos = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=int(qos_depth),
+                         reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE)
+        for c in conns:
+            if c.topic not in pubs:
+                pubs[c.topic] = node.create_publisher(classes[c.msgtype], remap.get(c.topic, c.topic), qos)
+        if clock:
+            from rosgraph_msgs.msg import Clock
+
+            clock_pub = node.create_publisher(Clock, "/clock", qos)
+        cache: dict = {}
+        dst = ros2_typestore() if not reader.is2 else None
+        convert = {c.msgtype: _cdr_converter(reader, c.msgtype, cache, dst) for c in conns}
+        if wait_subscribers_s > 0:
+            deadline = time.monotonic() + wait_subscribers_s
+            while time.monotonic() < deadline and any(p.get_subscription_count() == 0 for p in pubs.values()):
+                time.sleep(0.01)
+        if delay_s > 0:
+            time.sleep(delay_s)
+        bar = Progress(total, "iemd-play", progress)
+        t0_log = t0_wall = None
+        late_sum = 0.0
+        n = 0
+        for conn, log_t, raw in iter_messages(reader, conns, bag):
+            msg = deserialize_message(convert[conn.msgtype](raw), classes[conn.msgtype])
+            if t0_log is None:
+                t0_log, t0_wall = log_t, time.monotonic()
+            target = t0_wall + (log_t - t0_log) * 1e-9 / rate
+            while (wait := target - time.monotonic()) > 0:
+                time.sleep(min(wait, 0.05))
+            late = (time.monotonic() - target) * 1e3
+            if clock_pub is not None:
+                cm = Clock()
+                cm.clock.sec, cm.clock.nanosec = ns_to_stamp(log_t)
+                clock_pub.publish(cm)
+            pubs[conn.topic].publish(msg)
+            stats.published[conn.topic] = stats.published.get(conn.topic, 0) + 1
+            stats.max_late_ms = max(stats.max_late_ms, late)
+            late_sum += late
+            n += 1
+            stats.bag_s = (log_t - t0_log) * 1e-9
+            bar.update(1)
+        bar.close()
+        stats.wall_s = 0.0 if t0_wall is None else time.monotonic() - t0_wall
+        stats.mean_late_ms = late_sum / n if n else 0.0
+        return stats
+    finally:
+        reader.close()
+        if own_node and node is not None:
+            node.destroy_node()
+        elif node is not None:                     # a caller's node: remove what was added to it
+            for pub in [*pubs.values(), *([clock_pub] if clock_pub is not None else [])]:
+                node.destroy_publisher(pub)
+        if own_init:
+            rclpy.try_shutdown()
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = CliParser(prog="iemd-play", description=__doc__.split("\n\n")[0])
+    p.add_argument("bag", type=Path, help="rosbag2 folder (sqlite3/mcap) or ROS 1 .bag file")
+    p.add_argument("--rate", type=float, default=1.0, help="playback rate factor (default 1.0)")
+    p.add_argument("--topics", nargs="+", default=None, help="play only these topics")
+    p.add_argument("--remap", action="append", default=[], metavar="FROM:=TO", help="publish FROM under TO")
+    p.add_argument("--delay", type=float, default=0.0, metavar="S", help="sleep S seconds before playing")
+    p.add_argument("--wait-subscribers", type=float, default=0.0, metavar="S",
+                   help="wait up to S seconds until every topic has a subscriber")
+    p.add_argument("--clock", action="store_true", help="also publish /clock with the log times")
+    p.add_argument("--qos-depth", type=int, default=100, help="publisher queue depth (default 100)")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="progress bar on stderr (default: when stderr is a terminal)")
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    def body() -> int:
+        args, ros_args = split_ros_args(argv)
+        a = build_parser().parse_args(args)
+        stats = play(a.bag, a.rate, a.topics, _parse_remaps(a.remap), a.delay, a.wait_subscribers, a.clock,
+                     a.qos_depth, progress=a.progress, ros_args=ros_args)
+        n = sum(stats.published.values())
+        print(f"iemd-play: published {n} messages on {len(stats.published)} topics: {stats.bag_s:.2f} s of bag in "
+              f"{stats.wall_s:.2f} s wall (rate {a.rate:g}); late by {stats.mean_late_ms:.2f} ms on average, "
+              f"{stats.max_late_ms:.1f} ms at most")
+        return 0
+
+    return cli_main("iemd-play", body)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

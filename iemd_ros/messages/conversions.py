@@ -1,0 +1,318 @@
+"""ROS messages <-> numpy and the pipeline's inputs and outputs, without rclpy or cv_bridge.
+
+The functions read message fields by name and never import a message type, so ``rclpy`` messages
+(``data`` is an ``array.array`` or ``bytes``), ``rosbags`` messages (``data`` is a numpy array) and
+hand-made values all work:
+
+    frame = image_from_msg(msg)                  # an Image (image_to_array) or a CompressedImage (compressed_to_array)
+    t_ns, gyro, cov0 = imu_sample(msg)           # the arguments of TrackingPipeline.add_imu_message
+    camera = camera_model_from_msg(msg)          # CameraInfo, cached per content (ROS 1 or 2 field names)
+    fill_image_msg(Image(), frame)               # a frame into an Image's pixel fields
+    values = detection_values(result)            # a FrameResult's Detection2D values (or None)
+
+Pixel data is reinterpreted with ``np.frombuffer`` (no per-element Python loop); the returned frame
+is what :class:`iemd_ros.IemdTracker` takes: ``HxW`` uint8 (grey) or ``HxWx3`` uint8 BGR.
+"""
+from __future__ import annotations
+
+from functools import lru_cache
+from typing import NamedTuple
+
+import cv2
+import numpy as np
+
+from iemd_ros.gyro.camera import CameraModel
+from iemd_ros.common.boxes import box_centre, centre_box, check_box
+
+__all__ = ["ENCODINGS", "COMPRESSED_CODECS", "JPEG_QUALITY", "image_to_array", "compressed_to_array",
+           "array_to_image_fields", "array_to_compressed_fields", "check_compression", "compressed_topic",
+           "is_compressed_topic", "raw_twin", "fill_image_msg", "camera_model_from_info", "camera_model_from_msg",
+           "image_from_msg", "imu_sample", "stamp_to_ns", "stamp_ns", "ns_to_stamp", "box_to_bbox", "bbox_to_box",
+           "bbox_values", "fill_bbox",
+           "CLASS_ID", "DETECTION_ID", "DetectionValues", "detection_values"]
+
+# encoding -> (channels, bytes per channel)
+ENCODINGS = {"mono8": (1, 1), "mono16": (1, 2), "bgr8": (3, 1), "rgb8": (3, 1), "bgra8": (4, 1), "rgba8": (4, 1)}
+COMPRESSED_CODECS = ("jpeg", "png")  # image_transport's compressed plugin
+JPEG_QUALITY = 95  # its default quality
+
+
+def _as_bytes(data) -> memoryview:
+    """A flat byte view of ``data`` (bytes, bytearray, array.array, numpy array, list of ints)."""
+    if isinstance(data, np.ndarray):
+        return memoryview(np.ascontiguousarray(data).view(np.uint8).reshape(-1))
+    if isinstance(data, (list, tuple)):                 # rare: a hand-made message
+        return memoryview(np.asarray(data, dtype=np.uint8))
+    try:
+        return memoryview(data).cast("B")
+    except TypeError as exc:
+        raise ValueError(f"image data must be bytes-like, got {type(data).__name__}") from exc
+
+
+def image_to_array(encoding: str, height: int, width: int, step: int, data, is_bigendian: bool = False) -> np.ndarray:
+    """``sensor_msgs/Image`` fields -> tracker frame (``HxW`` uint8 or ``HxWx3`` uint8 BGR).
+
+    mono8/bgr8 are returned as views of ``data`` when the rows are unpadded; rgb8/bgra8/rgba8 are
+    converted to BGR (alpha dropped).  mono16 (either byte order) is reduced to 8 bits by the right
+    shift that puts the frame's highest set bit at bit 7 (a 12-bit sensor in mono16 keeps its 8 most
+    significant *used* bits instead of turning almost black under a fixed ``>> 8``; the shift only
+    changes when the frame maximum crosses a power of two, and the tracker normalizes the grey
+    levels of its window anyway).  Raises ValueError on an unknown encoding, a ``step`` shorter than
+    a row or a ``data`` size other than ``step * height``.
+    """
+    if encoding not in ENCODINGS:
+        raise ValueError(f"unsupported image encoding {encoding!r}: expected one of {', '.join(ENCODINGS)}")
+    height, width, step = int(height), int(width), int(step)
+    if height <= 0 or width <= 0:
+        raise ValueError(f"image is empty: {width}x{height}")
+    channels, depth = ENCODINGS[encoding]
+    row = width * channels * depth
+    if step < row:
+        raise ValueError(f"step {step} is shorter than one {encoding} row of {width} px ({row} bytes)")
+    buf = _as_bytes(data)
+    if len(buf) != step * height:
+        raise ValueError(f"image data has {len(buf)} bytes, expected step*height = {step}*{height} = {step * height}")
+    raw = np.frombuffer(buf, dtype=np.uint8).reshape(height, step)[:, :row]
+    if depth == 2:
+        return _to_8bit(raw.view(">u2" if is_bigendian else "<u2").reshape(height, width))
+    pix = raw.reshape(height, width, channels) if channels > 1 else raw
+    if encoding in ("mono8", "bgr8"):
+        return pix
+    if encoding == "rgb8":
+        return np.ascontiguousarray(pix[..., ::-1])
+    if encoding == "bgra8":
+        return np.ascontiguousarray(pix[..., :3])
+    return np.ascontiguousarray(pix[..., 2::-1])      # rgba8
+
+
+def _to_8bit(pixels: np.ndarray) -> np.ndarray:
+    """16-bit pixels -> uint8 by the right shift that puts the highest set bit at bit 7 (see image_to_array)."""
+    shift = max(0, int(pixels.max()).bit_length() - 8)
+    return (pixels >> shift).astype(np.uint8)
+
+
+def compressed_to_array(fmt: str, data) -> np.ndarray:
+    """``sensor_msgs/CompressedImage`` fields -> tracker frame (``HxW`` or ``HxWx3`` uint8 BGR).
+
+    ``fmt`` is as image_transport's compressed plugin writes it (``"jpeg"``, ``"png"`` or e.g.
+    ``"rgb8; jpeg compressed bgr8"``); the data are decoded by what they are (``cv2.imdecode``), which
+    gives BGR whatever the source encoding (the plugin stores colour as bgr8, and the codec's own
+    channel order is undone by OpenCV).  An alpha channel is dropped; 16-bit PNG (mono16/bgr16) is
+    reduced to 8 bits as mono16 in :func:`image_to_array`.  Raises ValueError for data that do not
+    decode, and for ``compressedDepth`` (depth maps, not camera images).
+    """
+    if "compresseddepth" in str(fmt).lower():
+        raise ValueError(f"compressed image format {fmt!r} is a depth map (compressedDepth), not a camera image")
+    buf = np.frombuffer(_as_bytes(data), dtype=np.uint8)
+    if buf.size == 0:
+        raise ValueError(f"compressed image ({fmt!r}) has no data")
+    try:
+        img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+    except cv2.error as exc:  # e.g. a header declaring more pixels than OpenCV accepts
+        raise ValueError(f"cannot decode the compressed image (format {fmt!r}, {buf.size} bytes): "
+                         f"{str(exc).strip().splitlines()[-1]}") from None
+    if img is None:
+        raise ValueError(f"cannot decode the compressed image (format {fmt!r}, {buf.size} bytes)")
+    if img.dtype == np.uint16:
+        img = _to_8bit(img)
+    elif img.dtype != np.uint8:
+        raise ValueError(f"compressed image ({fmt!r}) decodes to {img.dtype} pixels; expected 8 or 16 bits")
+    if img.ndim == 3 and img.shape[2] == 4:
+        img = img[..., :3]
+    return np.ascontiguousarray(img)
+
+
+def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dict:
+    """Tracker frame -> ``sensor_msgs/Image`` fields (``data`` as ``bytes``, the fast path for rclpy).
+
+    ``encoding`` defaults to mono8 for ``HxW`` and bgr8 for ``HxWx3`` uint8 frames; rgb8 flips the
+    channels.  :func:`fill_image_msg` sets them on a message.
+    """
+    frame = _check_frame(frame)
+    default = "mono8" if frame.ndim == 2 else "bgr8"
+    encoding = default if encoding is None else encoding
+    if encoding not in (default, "rgb8" if frame.ndim == 3 else default):
+        raise ValueError(f"cannot write a {frame.shape} frame as {encoding!r}")
+    if encoding == "rgb8":
+        frame = frame[..., ::-1]
+    h, w = frame.shape[:2]
+    channels = 1 if frame.ndim == 2 else 3
+    return dict(encoding=encoding, height=h, width=w, step=w * channels, is_bigendian=0,
+                data=np.ascontiguousarray(frame).tobytes())
+
+
+def _check_frame(frame) -> np.ndarray:
+    """``frame`` as an array, checked to be a tracker frame (``HxW`` or ``HxWx3`` uint8)."""
+    frame = np.asarray(frame)
+    if frame.dtype != np.uint8 or frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
+        raise ValueError(f"frame must be HxW or HxWx3 uint8, got {frame.dtype} {frame.shape}")
+    return frame
+
+
+def check_compression(codec: str, quality: int = JPEG_QUALITY) -> None:
+    """ValueError unless ``codec`` is one of :data:`COMPRESSED_CODECS` and ``quality`` a JPEG quality 1-100."""
+    if codec not in COMPRESSED_CODECS:
+        raise ValueError(f"codec must be {' or '.join(map(repr, COMPRESSED_CODECS))}, got {codec!r}")
+    if not 1 <= int(quality) <= 100:
+        raise ValueError(f"JPEG quality must be in [1, 100], got {quality}")
+
+
+def compressed_topic(image_topic: str) -> str:
+    """image_transport's name of an image topic's compressed stream: ``<image_topic>/compressed``."""
+    return image_topic.rstrip("/") + "/compressed"
+
+
+def is_compressed_topic(topic: str) -> bool:
+    """True for a name whose last part is ``compressed`` (image_transport's compressed stream)."""
+    return topic.rstrip("/").rpartition("/")[2] == "compressed"
+
+
+def raw_twin(topic: str) -> str | None:
+    """The image topic whose compressed stream ``topic`` is named as (inverse of :func:`compressed_topic`);
+    None for a name that is not ``<image>/compressed``."""
+    head = topic.rstrip("/").rpartition("/")[0]
+    return head if is_compressed_topic(topic) and head else None
+
+
+def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: int = JPEG_QUALITY) -> dict:
+    """Tracker frame -> ``sensor_msgs/CompressedImage`` fields as image_transport's compressed plugin
+    writes them: ``format`` ``"bgr8; jpeg compressed bgr8"``, for ``HxW`` ``"mono8; jpeg compressed "``
+    (the plugin names a target encoding for colour only; ``png`` is lossless) and the encoded ``data``
+    as ``bytes``.  ``quality``: JPEG quality, 1-100."""
+    frame = _check_frame(frame)
+    check_compression(codec, quality)
+    params = [cv2.IMWRITE_JPEG_QUALITY, int(quality)] if codec == "jpeg" else []
+    ok, buf = cv2.imencode(".jpg" if codec == "jpeg" else ".png", frame, params)
+    if not ok:
+        raise ValueError(f"OpenCV could not encode a {frame.shape} frame as {codec}")
+    fmt = f"mono8; {codec} compressed " if frame.ndim == 2 else f"bgr8; {codec} compressed bgr8"
+    return dict(format=fmt, data=buf.tobytes())
+
+
+def fill_image_msg(msg, frame: np.ndarray, encoding: str | None = None):
+    """Set a ``sensor_msgs/Image``'s pixel fields from a tracker frame (:func:`array_to_image_fields`);
+    returns ``msg``.  The header is the caller's.  ``data`` goes in as ``bytes``: an rclpy message copies
+    that in about 0.06 ms, where a numpy array costs ~68 ms per 640x480x3 frame."""
+    for name, value in array_to_image_fields(frame, encoding).items():
+        setattr(msg, name, value)
+    return msg
+
+
+def camera_model_from_msg(msg) -> CameraModel:
+    """The camera model of a ``sensor_msgs/CameraInfo`` (ROS 2 ``k``/``d`` or ROS 1 ``K``/``D`` fields).
+
+    A driver repeats the same CameraInfo with every image; each content is turned into a model once
+    (building one cost 0.2 ms per message).  Bad content raises ValueError (not cached).
+    """
+    k = getattr(msg, "k", None)
+    d = getattr(msg, "d", None)
+    if k is None:                                  # ROS 1 field names
+        k, d = msg.K, msg.D
+    return _camera_model(tuple(map(float, k)), tuple(map(float, d)), msg.distortion_model, msg.width, msg.height)
+
+
+@lru_cache(maxsize=4)
+def _camera_model(k: tuple, d: tuple, distortion_model: str, width: int, height: int) -> CameraModel:
+    return camera_model_from_info(k, d, distortion_model, width, height)
+
+
+def camera_model_from_info(k, d, distortion_model: str, width: int, height: int) -> CameraModel:
+    """``sensor_msgs/CameraInfo`` fields -> :class:`~iemd_ros.gyro.camera.CameraModel` (K and plumb_bob D).
+
+    An all-zero ``k`` (an uncalibrated driver) and non-plumb_bob models with non-zero coefficients
+    raise ValueError saying so.
+    """
+    K = np.asarray(k, dtype=float).ravel()
+    if K.shape != (9,):
+        raise ValueError(f"camera_info k must have 9 values, got {K.size}")
+    if not np.any(K):
+        raise ValueError("camera_info k is all zero: the camera is not calibrated")
+    D = np.asarray(d, dtype=float).ravel()
+    w, h = int(width), int(height)
+    return CameraModel.from_camera_info(dict(k=K, d=D, distortion_model=distortion_model or "plumb_bob",
+                                             width=w if w > 0 else None, height=h if h > 0 else None))
+
+
+def stamp_to_ns(sec: int, nanosec: int) -> int:
+    """``builtin_interfaces/Time`` -> integer nanoseconds."""
+    return int(sec) * 1_000_000_000 + int(nanosec)
+
+
+def image_from_msg(msg) -> np.ndarray:
+    """A ``sensor_msgs/Image`` (:func:`image_to_array`) or ``sensor_msgs/CompressedImage``
+    (:func:`compressed_to_array`), rclpy or rosbags message -> tracker frame."""
+    if hasattr(msg, "format"):  # CompressedImage: header, format, data
+        return compressed_to_array(msg.format, msg.data)
+    return image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, bool(msg.is_bigendian))
+
+
+def imu_sample(msg) -> tuple[int, tuple[float, float, float], float]:
+    """A ``sensor_msgs/Imu`` (rclpy or rosbags message) -> (stamp ns, gyro rates (x, y, z) rad/s,
+    ``angular_velocity_covariance[0]``): the arguments of ``TrackingPipeline.add_imu_message``."""
+    w = msg.angular_velocity
+    return stamp_ns(msg.header), (w.x, w.y, w.z), msg.angular_velocity_covariance[0]
+
+
+def stamp_ns(header) -> int:
+    """Nanoseconds of a ``std_msgs/Header`` (rclpy or rosbags message, ROS 1 or 2)."""
+    return stamp_to_ns(header.stamp.sec, header.stamp.nanosec)
+
+
+def ns_to_stamp(t_ns: int) -> tuple[int, int]:
+    """Integer nanoseconds -> ``(sec, nanosec)`` with ``0 <= nanosec < 1e9``."""
+    sec, nsec = divmod(int(t_ns), 1_000_000_000)
+    return sec, nsec
+
+
+def box_to_bbox(box) -> tuple[float, float, float, float]:
+    """Tracker box ``(x, y, w, h)`` -> ``vision_msgs/BoundingBox2D`` ``(center_x, center_y, size_x, size_y)``.
+
+    The centre is in pixel-index coordinates (pixel centres at integers, as ``K``):
+    ``x + (w - 1) / 2`` (:func:`iemd_ros.common.boxes.box_centre`); the size is ``w, h`` pixels.
+    """
+    b = check_box(box)
+    cx, cy = box_centre(b)
+    return float(cx), float(cy), b[2], b[3]
+
+
+def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) -> tuple[float, float, float, float]:
+    """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size.
+
+    The values are checked as given (``check_box``'s last two are the sizes), so the
+    message shows what the sender wrote, not the corner box derived from it.
+    """
+    cx, cy, sx, sy = check_box((center_x, center_y, size_x, size_y), "bounding box (center_x, center_y, size_x, size_y)")
+    return tuple(float(v) for v in centre_box((cx, cy), (sx, sy)))
+
+
+def bbox_values(bbox) -> tuple[float, float, float, float]:
+    """A ``vision_msgs/BoundingBox2D`` (rclpy or rosbags message) -> ``(center_x, center_y, size_x, size_y)``."""
+    c = bbox.center.position
+    return c.x, c.y, bbox.size_x, bbox.size_y
+
+
+def fill_bbox(bbox, values) -> None:
+    """Set a ``vision_msgs/BoundingBox2D``'s centre and size from ``(center_x, center_y, size_x, size_y)``
+    (:func:`box_to_bbox`'s values); ``theta`` is left as it is."""
+    c = bbox.center.position
+    c.x, c.y, bbox.size_x, bbox.size_y = (float(v) for v in values)
+
+
+CLASS_ID = "target"  # default class_id of the published hypothesis (node parameter ``class_id``)
+DETECTION_ID = "iemd"  # default id of the published Detection2D (node parameter ``detection_id``)
+
+
+class DetectionValues(NamedTuple):
+    """Values of the tracker's ``vision_msgs/Detection2D``: ``bbox`` ``(center_x, center_y, size_x, size_y)``
+    (``theta`` 0) and its one hypothesis' ``score``."""
+
+    bbox: tuple[float, float, float, float]
+    score: float
+
+
+def detection_values(result) -> DetectionValues | None:
+    """A :class:`~iemd_ros.pipeline.pipeline.FrameResult` -> its detection's values (:func:`box_to_bbox` of its box,
+    its score); None when ``result`` is None or not tracking: no detection is published then."""
+    if result is None or not result.tracking:
+        return None
+    return DetectionValues(box_to_bbox(result.box), float(result.score))

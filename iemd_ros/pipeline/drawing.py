@@ -1,0 +1,42 @@
+"""A tracking result drawn on its frame (ROS-free): the node's ``~/debug_image`` and the replay's video."""
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from iemd_ros.pipeline.pipeline import FrameResult
+
+__all__ = ["draw_result"]
+
+# BGR
+TRACKING, LOST, INIT, GYRO = (0, 200, 0), (0, 0, 255), (255, 200, 0), (0, 220, 255)
+
+
+def draw_result(frame: np.ndarray, r: FrameResult) -> np.ndarray:
+    """BGR copy of ``frame`` with ``r`` drawn: the box (green tracking, red lost, light blue on the
+    init frame), the gyro's predicted box (thin, yellow) and a line with the stamp and state."""
+    img = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR) if frame.ndim == 2 else frame.copy()
+    if r.gyro_box is not None:
+        _rect(img, r.gyro_box, GYRO, 1)
+    if r.box is not None:
+        _rect(img, r.box, INIT if r.is_init else TRACKING if r.tracking else LOST, 2)
+    text = f"{r.stamp_ns / 1e9:.3f}s {_status(r)}"
+    cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 3, cv2.LINE_AA)
+    cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
+    return img
+
+
+def _status(r: FrameResult) -> str:
+    if r.is_init:
+        return "initialized"
+    if r.rejected or r.box is None:
+        return r.rejected or r.state
+    return (f"{r.state} EMD {r.emd:.4f} it {r.iterations} {'gyro' if r.gyro_used else 'no gyro'} "
+            f"{r.processing_ms:.0f} ms")
+
+
+def _rect(img: np.ndarray, box, colour, thickness: int) -> None:
+    """Box ``(x, y, w, h)`` covering pixels ``x .. x+w-1`` (0-based)."""
+    x, y, w, h = box
+    cv2.rectangle(img, (int(round(x)), int(round(y))), (int(round(x + w - 1)), int(round(y + h - 1))),
+                  colour, thickness)

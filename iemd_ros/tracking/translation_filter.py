@@ -1,0 +1,108 @@
+"""Discriminative evidence of the window's position: a correlation filter over a search region (DSST/MOSSE).
+
+Why the tracker needs it: the iEMD histograms are a generative model with no notion of background.
+Where the target turns or is partly hidden, a window on background or on a similar object can score
+an EMD as low as the target's (Jogging-1: 0.40-0.58 on the target, 0.55 on the post that hides it),
+so the EMD alone cannot choose between the starting points that Algorithm 1 descends from.  A
+correlation filter is trained on the target against its own surroundings, the complementary view.
+
+The filter is DSST's translation filter (Danelljan et al., BMVC 2014; MOSSE with several channels):
+the window padded by ``padding`` on each axis is resampled to about ``model_area`` pixels and
+described by the gradient-orientation histograms of :func:`iemd_ros.tracking.correlation_filter.orientation_histograms`
+(cells of 4 model pixels), tapered by a Hann window; the desired response is a Gaussian of ``sigma_factor``
+times the target's size (in cells) at the window centre.  ``estimate`` gives the displacement where
+the response peaks and keeps the response map, which ``response_at`` reads at any window centre.  The
+tracker (``TrackerConfig.translation_weight``) takes the displacement as one more start and the response
+as evidence against the EMD when it chooses among the descended starts.
+
+Choices, measured over the 12 OTB sequences x 5 starts with every start descended (mean average overlap
+40.0 % with these defaults, 35.8 % without the filter): padding 1.5 (2.0: 38.1 %), learning rate 0.025
+(0.05 / 0.012: 37.7 / 36.1 %), sigma_factor 0.1 (DSST's 1/16: 35.8 %, 0.2: 38.0 %), model area 4096 px
+(2048 / 8192: 40.2 / 37.1 %).  With the defaults of 2026-11-23 (the default search scoring 38.6 %) learning
+rates 0.015 / 0.04 scored 35.0 / 36.3 %.
+Estimate and update take about 1 ms per frame together.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from iemd_ros.tracking.appearance import ImagePyramid, window_axes
+from iemd_ros.tracking.correlation_filter import CELL, FilterModel, hann, model_size, orientation_histograms, parabola_peak
+
+
+class TranslationFilter:
+    """``init`` at the target's window, per frame ``estimate`` at the predicted window (then
+    ``response_at`` for candidate centres) and, when the frame is tracked, ``update`` at the tracked window.
+
+    Windows are (centre, size (w, h), angle) as in :meth:`ImagePyramid.sample`.
+    """
+
+    def __init__(self, padding: float = 1.5, learning_rate: float = 0.025, regularization: float = 0.01,
+                 sigma_factor: float = 0.1, model_area: int = 4096):
+        if padding < 0:
+            raise ValueError(f"padding must be >= 0, got {padding}")
+        self.padding = padding
+        self.sigma_factor = sigma_factor
+        self.model_area = model_area
+        self.model_size = None  # (w, h) of the resampled search region, multiples of CELL
+        self._filter = FilterModel(learning_rate, regularization, channel_axis=-1)  # spectra (rows, cols, d)
+        self._response = None  # (response map, centre, cell size in image px, angle) of the last estimate
+
+    def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
+        """Learn the filter from the window (``center``, ``size``) of the first frame."""
+        self.model_size = model_size(self._region(size), self.model_area, min_cells=4)
+        cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
+        self._taper = np.outer(hann(rows), hann(cols))[..., None]
+        sigma = self.sigma_factor * np.sqrt(cols * rows) / (1.0 + self.padding)
+        ys, xs = np.arange(rows) - rows // 2, np.arange(cols) - cols // 2
+        peak = np.exp(-0.5 * (ys[:, None] ** 2 + xs[None, :] ** 2) / sigma**2)
+        self._desired = np.fft.fft2(np.fft.ifftshift(peak))[..., None]  # peak at cell (0, 0)
+        self._filter.reset()
+        self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
+        self._response = None
+
+    def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> np.ndarray:
+        """Displacement (dx, dy), image pixels, from ``center`` to where the response peaks in the region around
+        the window (``center``, ``size``), refined between cells by a parabola through the peak."""
+        if not self._filter.trained:
+            raise RuntimeError("TranslationFilter.estimate() called before init()")
+        response = np.fft.ifft2(self._filter.response(self._spectrum(pyramid, center, size, angle))).real
+        rows, cols = response.shape
+        cell_px = self._region(size) / [cols, rows]
+        self._response = (response, np.asarray(center, dtype=np.float64), cell_px, angle)
+        r, c = np.unravel_index(int(np.argmax(response)), response.shape)
+        peak = response[r, c]
+        dy = parabola_peak(response[(r - 1) % rows, c], peak, response[(r + 1) % rows, c])
+        dx = parabola_peak(response[r, (c - 1) % cols], peak, response[r, (c + 1) % cols])
+        cells = np.array([(c + cols // 2) % cols - cols // 2 + dx, (r + rows // 2) % rows - rows // 2 + dy])
+        return window_axes(angle) @ (cells * cell_px)
+
+    def response_at(self, point) -> float:
+        """The last estimate's response at image point ``point`` (bilinear between cells; 0 outside the region)."""
+        if self._response is None:
+            raise RuntimeError("TranslationFilter.response_at() needs an estimate() first")
+        response, center, cell_px, angle = self._response
+        rows, cols = response.shape
+        c, r = window_axes(angle).T @ (np.asarray(point, dtype=np.float64) - center) / cell_px
+        c0, r0 = int(np.floor(c)), int(np.floor(r))
+        value = 0.0
+        for rr, wr in ((r0, r0 + 1 - r), (r0 + 1, r - r0)):
+            for cc, wc in ((c0, c0 + 1 - c), (c0 + 1, c - c0)):
+                if abs(rr) <= rows // 2 and abs(cc) <= cols // 2:  # cyclic map: no wrap-around
+                    value += wr * wc * response[rr % rows, cc % cols]
+        return float(value)
+
+    def update(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
+        """Blend in a sample at the tracked window (the running average of DSST eq. 5)."""
+        self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
+
+    def _region(self, size) -> np.ndarray:
+        """(w, h) in image pixels of the search region around a window of ``size``: its size times 1 + ``padding``."""
+        return np.asarray(size, dtype=np.float64) * (1.0 + self.padding)
+
+    def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
+        """2-D FFT of the tapered (rows, cols, d) features of the search region around the window."""
+        sample = pyramid.sample(center, self._region(size), self.model_size, angle=angle)
+        cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
+        features = orientation_histograms(sample[None]).reshape(rows, cols, -1)
+        return np.fft.fft2(features * self._taper, axes=(0, 1))
