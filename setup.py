@@ -17,7 +17,7 @@ from setuptools import find_packages, setup
 PACKAGE = "iemd_ros"
 HERE = os.path.dirname(os.path.abspath(__file__))
 # ros2 run executables: name -> module with main()
-EXECUTABLES = {"tracker": "iemd_ros.ros.node", "replay": "iemd_ros.bags.replay"}
+EXECUTABLES = {"tracker": "iemd_ros.ros.node", "replay": "iemd_ros.apps.replay"}
 WRAPPER_DIR = os.path.join("build", "ros_executables")
 
 WRAPPER = '''#!/bin/sh
@@ -75,11 +75,11 @@ setup(
     entry_points={
         "console_scripts": [
             "iemd-demo = iemd_ros.apps.demo:main",
-            "iemd-eval = iemd_ros.evaluation.ope:main",
+            "iemd-eval = iemd_ros.apps.eval:main",
             "iemd-tracker = iemd_ros.ros.node:main",
-            "iemd-replay = iemd_ros.bags.replay:main",
-            "iemd-make-bag = iemd_ros.bags.make:main",
-            "iemd-play = iemd_ros.bags.play:main",
+            "iemd-replay = iemd_ros.apps.replay:main",
+            "iemd-make-bag = iemd_ros.apps.make_bag:main",
+            "iemd-play = iemd_ros.apps.play:main",
         ],
     },
 )

@@ -24,7 +24,8 @@ import numpy as np
 
 from iemd_ros import TrackerConfig
 from iemd_ros.evaluation.metrics import score_sequence
-from iemd_ros.datasets.recordings import load_recording, track_recording
+from iemd_ros.datasets.recordings import load_recording
+from iemd_ros.evaluation.recording import track_recording
 
 DEFAULT_ROOT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu"
 

@@ -16,7 +16,8 @@ import sys
 
 import numpy as np
 
-from iemd_ros.gyro.predictor import GyroConfig, GyroPredictor, warp_points
+from iemd_ros.gyro import GyroConfig, GyroPredictor
+from iemd_ros.gyro.predictor import warp_points
 from iemd_ros.datasets.synthetic import SyntheticConfig, generate
 
 R_CI = np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]])        # IMU axes: a proper signed permutation

@@ -10,7 +10,8 @@ from bag_fixtures import IMG, IMG_COMPRESSED, IMU, INFO, by_topic, make_bag, rea
 from helpers import REPO, cli_error, run_module
 
 from iemd_ros.bags.io import custom_data, open_bag
-from iemd_ros.bags.make import main, source_from_folder, write_bag
+from iemd_ros.apps.make_bag import main
+from iemd_ros.bags.make import source_from_folder, write_bag
 from iemd_ros.messages.conversions import image_from_msg
 from iemd_ros.datasets.otb import load_sequence, parse_groundtruth
 from iemd_ros.datasets.recordings import load_recording
@@ -237,6 +238,6 @@ def test_cli_compress_and_quality(seq, tmp_path, capsys):
 
 def test_cli_process(tmp_path):
     """The real process: exit status 2 and one line, no traceback."""
-    out = run_module("iemd_ros.bags.make", str(tmp_path / "missing"), str(tmp_path / "o"), cwd=REPO)
+    out = run_module("iemd_ros.apps.make_bag", str(tmp_path / "missing"), str(tmp_path / "o"), cwd=REPO)
     assert out.returncode == 2 and "Traceback" not in out.stderr
     assert out.stderr.strip().count("\n") == 0 and "is not a folder" in out.stderr

@@ -27,9 +27,10 @@ from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu  # noqa: E40
 from vision_msgs.msg import Detection2DArray  # noqa: E402
 
 from iemd_ros.bags.make import source_from_folder, write_bag  # noqa: E402
-from iemd_ros.bags.play import main, play  # noqa: E402
+from iemd_ros.apps.play import main  # noqa: E402
+from iemd_ros.ros.play import play  # noqa: E402
 from iemd_ros.messages.conversions import stamp_ns  # noqa: E402
-from iemd_ros.pipeline.pipeline import PipelineConfig  # noqa: E402
+from iemd_ros.pipeline import PipelineConfig  # noqa: E402
 from iemd_ros.bags.replay import replay  # noqa: E402
 
 BOX_TOL_PX = 1e-6

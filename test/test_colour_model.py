@@ -82,7 +82,7 @@ def test_invalid_parameters_and_calls_raise():
         ColourModel().estimate(_scene(), (70, 55), (20, 30))
     with pytest.raises(RuntimeError, match="estimate"):
         ColourModel().score_at((70, 55))
-    with pytest.raises(ValueError, match="colour_weight must be >= 0"):
+    with pytest.raises(ValueError, match=r"colour_weight must be in \[0, 100\]"):
         TrackerConfig(colour_weight=-1.0)
 
 

@@ -11,7 +11,7 @@ from iemd_ros.messages.conversions import (array_to_compressed_fields, array_to_
                                   box_to_bbox, camera_model_from_info, compressed_to_array, detection_values,
                                   fill_bbox, fill_image_msg, image_from_msg, image_to_array, imu_sample, ns_to_stamp,
                                   stamp_to_ns)
-from iemd_ros.pipeline.pipeline import FrameResult
+from iemd_ros.pipeline import FrameResult, Rejection, TrackState
 
 
 @pytest.fixture
@@ -134,11 +134,11 @@ def test_bbox_message_fields_round_trip():
 
 def test_detection_values_only_while_tracking():
     box = (10.0, 20.0, 4.0, 6.0)
-    v = detection_values(FrameResult(0, "tracking", box, score=0.75))
+    v = detection_values(FrameResult(stamp_ns=0, state=TrackState.TRACKING, box=box, score=0.75))
     assert v.bbox == (11.5, 22.5, 4.0, 6.0) and v.score == 0.75 and type(v.score) is float
     assert detection_values(None) is None
-    assert detection_values(FrameResult(0, "lost", box, lost=True)) is None
-    assert detection_values(FrameResult(0, "tracking", box, score=0.75, rejected="stamp repeats")) is None
+    assert detection_values(FrameResult(stamp_ns=0, state=TrackState.LOST, box=box, lost=True)) is None
+    assert detection_values(FrameResult(stamp_ns=0, state=TrackState.TRACKING, box=box, score=0.75, rejection=Rejection.STAMP, reason="stamp repeats")) is None
 
 
 def test_box_centre_and_centre_box_are_inverse():

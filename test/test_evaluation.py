@@ -9,7 +9,8 @@ from helpers import PNG_SIGNATURE, cli_error, node_parameter_file, run_module
 
 from iemd_ros import TrackerConfig
 from iemd_ros.evaluation import ope as evaluation
-from iemd_ros.evaluation.ope import main, make_tracker, run_tracker, sequence_names
+from iemd_ros.apps.eval import main
+from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.datasets.otb import load_sequence
 
 # Measured on Car4 frames 1-20 (OpenCV 5.0.0 contrib): CSRT average overlap 85.8 %, KCF 87.9 %.
@@ -149,7 +150,7 @@ def test_bad_arguments_exit_2_one_line(argv, match, capsys):
 
 
 def test_bad_argument_subprocess_no_traceback(tmp_path):
-    proc = run_module("iemd_ros.evaluation.ope", str(tmp_path), "--trackers", "kcf", timeout=60)
+    proc = run_module("iemd_ros.apps.eval", str(tmp_path), "--trackers", "kcf", timeout=60)
     assert proc.returncode == 2
     assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
     assert "holds no OTB sequence" in proc.stderr

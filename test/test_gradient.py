@@ -1,4 +1,4 @@
-"""Gradients of the EMD with respect to the window position (eqs. 9-10 and the envelope form)."""
+"""Gradients of the EMD with respect to the window position (eqs. 9-10, and the appearance gradient)."""
 from dataclasses import replace
 
 import numpy as np
@@ -6,6 +6,7 @@ import pytest
 from helpers import shifted, texture
 
 from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.tracking.analysis import search_context
 from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking.candidate import CandidateModel
@@ -23,24 +24,24 @@ def model_setup():
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
     center = box_centre(box)
-    model = CandidateModel(tracker.search_context(ImagePyramid(to_gray(frame1))), center, np.array(box[2:], float))
+    model = CandidateModel(search_context(tracker, ImagePyramid(to_gray(frame1))), center, np.array(box[2:], float))
     return tracker, model
 
 
 def test_candidate_at_is_the_same_model_at_another_window(model_setup):
     """CandidateModel.at (Algorithm 1's next iterate, a scale variant) keeps the frame, target,
-    dictionary, pyramid level and orientation, and equals a model built at that window."""
+    dictionary and orientation, and equals a model built at that window."""
     tracker, model = model_setup
 
-    def context(dictionary, coarse=0, angle=0.0):  # a new context, with the fixture model's frame and target
-        return replace(model.context, dictionary=dictionary, coarse=coarse, angle=angle)
+    def context(dictionary, angle=0.0):  # a new context, with the fixture model's frame and target
+        return replace(model.context, dictionary=dictionary, angle=angle)
 
-    turned = CandidateModel(context(None, coarse=1, angle=0.3), model.center, model.size)
+    turned = CandidateModel(context(None, angle=0.3), model.center, model.size)
     for start, dictionary in ((model, tracker.dictionary), (turned, None)):
         center, size = start.center + (1.7, -0.4), start.size * 1.02
         moved = start.at(center, size)
-        built = CandidateModel(context(dictionary, coarse=start.coarse, angle=start.angle), center, size)
-        assert (moved.coarse, moved.angle) == (start.coarse, start.angle)
+        built = CandidateModel(context(dictionary, angle=start.angle), center, size)
+        assert moved.angle == start.angle
         np.testing.assert_array_equal(moved.template, built.template)
         np.testing.assert_array_equal(moved.code_weights, built.code_weights)
         assert moved.emd()[0] == built.emd()[0] != start.emd()[0]
@@ -63,17 +64,6 @@ def test_candidate_emd_uses_the_ground_distance(model_setup, y):
     assert 0 < value < 1
 
 
-@pytest.mark.parametrize("y0", [(0.03, -0.02), (-0.05, 0.04), (0.08, 0.01)])
-def test_envelope_gradient_matches_finite_differences(model_setup, y0):
-    _, model = model_setup
-    y0 = np.array(y0)
-    _, grad, _ = model.evaluate("envelope", y0)
-    h = 1e-6
-    fd = np.array([(model.emd(y0 + h * e)[0] - model.emd(y0 - h * e)[0]) / (2 * h)
-                   for e in np.eye(2)])
-    assert np.allclose(grad, fd, rtol=1e-3, atol=1e-6), (grad, fd)
-
-
 def test_paper_gradient_is_the_derivative_through_the_weights_only(model_setup):
     """Eq. (10) differentiates D* through w_C(y) with the ground distances held fixed."""
     tracker, model = model_setup
@@ -82,8 +72,8 @@ def test_paper_gradient_is_the_derivative_through_the_weights_only(model_setup):
     y0 = next(np.array(y) for y in [(0.04, -0.03), (0.037, -0.021), (0.051, 0.013), (0.021, 0.033)]
               if np.abs(1 - ((model.pos - y) ** 2).sum(1) / cfg.kernel_bandwidth**2).min() > 1e-3)
     _, grad_paper, _ = model.evaluate("paper", y0)
-    _, grad_full, _ = model.evaluate("envelope", y0)
     h = 1e-6
+    grad_full = np.array([(model.emd(y0 + h * e)[0] - model.emd(y0 - h * e)[0]) / (2 * h) for e in np.eye(2)])
     probes = [y0 + d for d in (h, -h) for d in np.eye(2) * d]
     keep = np.any([candidate_weights(model.code_weights, model.pos, y, cfg.kernel_bandwidth)[0] > 0
                    for y in [y0] + probes], axis=0)
@@ -107,7 +97,7 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     tracker = IemdTracker(TrackerConfig(gradient="appearance"))
     box = (120, 80, 48, 40)
     tracker.init(frame0, box)
-    context = tracker.search_context(ImagePyramid(to_gray(frame1)))
+    context = search_context(tracker, ImagePyramid(to_gray(frame1)))
     center = box_centre(box)
     size = np.array(box[2:], float)
 
@@ -123,20 +113,18 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
     assert grad @ fd > 0.95 * np.linalg.norm(grad) * np.linalg.norm(fd)
 
 
-@pytest.mark.parametrize("mode,bound", [("patch", 0.1), ("l2", 0.1), ("window", 0.25)])
-def test_patch_jacobian_matches_finite_differences_of_the_resampled_patches(mode, bound):
-    """d epsilon / d(window shift) of PatchLayout.extract_with_jacobian (numba) on a smooth image.
-    Measured relative errors: patch 0.05-0.06, l2 0.04-0.05, window 0.10-0.17 (its window mean and
-    contrast are treated as constant)."""
+def test_patch_jacobian_matches_finite_differences_of_the_resampled_patches():
+    """d epsilon / d(window shift) of PatchLayout.extract_with_jacobian (numba) on a smooth image, within 10 %
+    (the central differences of the template's grey levels approximate the resampling's derivative)."""
     import cv2
 
     rng = np.random.default_rng(0)
     image = cv2.GaussianBlur(rng.uniform(0, 1, (120, 160)).astype(np.float32), (0, 0), 4)
     pyramid = ImagePyramid((image - image.min()) / (image.max() - image.min()))
-    layout = PatchLayout((32, 32), (8, 8), 4, mode)
+    layout = PatchLayout((32, 32), (8, 8), 4)
     center, size, h = np.array([80.0, 60.0]), np.array([32.0, 32.0]), 0.05
     _, jac = layout.extract_with_jacobian(pyramid.sample(center, size, (32, 32)))
     for k, e in enumerate(np.eye(2)):
         fd = (layout.extract(pyramid.sample(center + h * e, size, (32, 32)))
               - layout.extract(pyramid.sample(center - h * e, size, (32, 32)))) / (2 * h)
-        assert np.linalg.norm(jac[..., k] - fd) < bound * np.linalg.norm(fd)
+        assert np.linalg.norm(jac[..., k] - fd) < 0.1 * np.linalg.norm(fd)

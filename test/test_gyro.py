@@ -5,7 +5,8 @@ from helpers import DESK_D, DESK_K
 
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.gyro.camera import CameraModel
-from iemd_ros.gyro.predictor import (GyroConfig, GyroPredictor, box_grid, local_prior, predict_box,
+from iemd_ros.gyro import GyroConfig, GyroPredictor
+from iemd_ros.gyro.predictor import (box_grid, local_prior, predict_box,
                            rotation_homography, warp_difference, warp_points)
 from iemd_ros.gyro.imu import Coverage
 from iemd_ros.evaluation.metrics import iou
@@ -153,14 +154,19 @@ def test_bad_arguments():
 
 
 def test_gyro_config_checks_itself():
-    """The checks of the predictor's parts, raised by the configuration when built."""
-    bad = [({"R_cam_imu": np.diag([1.0, 1.0, -1.0])}, "proper 3x3 rotation"), ({"bias": [0.0, np.nan, 0.0]}, "bias"),
-           ({"buffer_samples": 1}, "max_samples >= 2"), ({"buffer_ns": 0}, "max_duration_ns > 0"),
-           ({"saturation": 0.0}, "saturation limit"), ({"max_gap_ns": 0}, "max_gap_ns must be > 0"),
-           ({"still_bias_samples": 1}, "still-bias sample count"), ({"still_bias_max_std": 0.0}, "still-bias max_std")]
+    """The declared ranges, and the checks of the predictor's parts, raised by the configuration when built."""
+    bad = [({"R_cam_imu": np.diag([1.0, 1.0, -1.0])}, "proper 3x3 rotation"),
+           ({"R_cam_imu": [1.0, 0.0, 0.0]}, "gyro.R_cam_imu must have 9 values"),
+           ({"bias": [0.0, np.nan, 0.0]}, r"gyro.bias\[1\] must be finite"),
+           ({"buffer_samples": 1}, r"gyro.buffer_samples must be in \[2, "), ({"buffer_ns": 0}, "gyro.buffer_ns"),
+           ({"saturation": -1.0}, "gyro.saturation"), ({"max_gap_ns": 0}, "gyro.max_gap_ns"),
+           ({"still_bias_samples": 1}, "still-bias sample count"), ({"still_bias_max_std": 0.0}, "still_bias_max_std"),
+           ({"time_offset_ns": 0.5}, "gyro.time_offset_ns must be an integer")]
     for kw, msg in bad:
         with pytest.raises(ValueError, match=msg):
             GyroConfig(**kw)
+    assert GyroConfig(saturation=0.0).saturation_limit is None and GyroConfig(saturation=35.0).saturation_limit == 35.0
+    assert GyroConfig(R_cam_imu=np.eye(3)).R_cam_imu == GyroConfig().R_cam_imu
 
 
 def test_real_desk_prewarp_direction(imu_root):
@@ -205,7 +211,8 @@ def test_real_desk_close_up_with_roll_is_tracked_with_the_gyro(imu_root):
     """CMU desk frames 500-580: the camera closes in on the eagle's head and rolls it by ~160 deg.
     Measured: mean IoU 0.73 (min 0.65) with the gyro prior, the window turning to -160 deg; without it 0.46,
     the last 20 frames at most 0.30 (0.17 over all frames before the translation filter)."""
-    from iemd_ros.datasets.recordings import load_recording, track_recording
+    from iemd_ros.datasets.recordings import load_recording
+    from iemd_ros.evaluation.recording import track_recording
 
     rec = load_recording(imu_root / "cmu_hwangbo_desk")
     start, stop = 500, 580

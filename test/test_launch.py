@@ -14,7 +14,7 @@ import yaml
 from catkin_pkg import package as catkin_package
 from helpers import REPO
 
-from iemd_ros.pipeline.pipeline import NODE_NAME
+from iemd_ros.ros.parameters import NODE_NAME
 
 LAUNCH = REPO / "launch" / "tracker.launch.xml"
 SUBSTITUTION = re.compile(r"\$\((\S+)\s+([^)]*)\)")

@@ -166,12 +166,12 @@ def test_parameters_are_validated_with_reasons(ctx):
         assert drv.wait_for(lambda: node.pipeline.config.tracker.n_iter == 10, 5.0)
         assert node.pipeline.config.gyro.time_offset_ns == 2_000_000
         cases = {
-            "tracker.min_step_px": (50.0, "min_step_px <= step_px"),     # cross-field rule of TrackerConfig
+            "tracker.min_step_px": (50.0, "must not exceed step_px"),    # cross-field rule of TrackerConfig
             "tracker.alpha": (2.0, "out of range"),                      # descriptor range
             "tracker.gradient": ("sideways", "gradient must be"),
             "tracker.lam": (1, "Wrong parameter type"),                  # integer for a double
             "gyro.R_cam_imu": ([1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, -1.0], "proper 3x3 rotation"),
-            "gyro.bias": ([0.0, 0.0], "3 finite values"),
+            "gyro.bias": ([0.0, 0.0], "gyro.bias must have 3 values"),
             "initial_box": ([1.0, 2.0], "initial_box ([] for none) must be 4 numbers"),
             "reliable_qos": (False, "read-only"),
         }
@@ -279,7 +279,7 @@ def test_an_image_topic_remapped_to_a_compressed_stream_is_taken_as_it_is(ctx):
 
 
 def test_unknown_image_transport_is_refused(ctx):
-    with pytest.raises(ValueError, match="image_transport must be 'raw' or 'compressed', got 'theora'"):
+    with pytest.raises(ValueError, match="image_transport must be one of raw, compressed, got 'theora'"):
         TrackerNode(context=ctx, parameter_overrides=[Parameter("image_transport", value="theora")])
 
 

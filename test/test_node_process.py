@@ -71,7 +71,7 @@ def test_invalid_parameter_exits_2_with_one_line(executable):
                               capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2, proc.stderr
     assert "Traceback" not in proc.stderr
-    assert "invalid parameters: invalid tracker config: need 0 < min_step_px <= step_px" in proc.stderr
+    assert "invalid parameters: tracker.min_step_px (0.5) must not exceed step_px (0.1)" in proc.stderr
 
 
 def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable, stop_process):

@@ -6,10 +6,12 @@ import pytest
 
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.gyro.camera import CameraModel
-from iemd_ros.gyro.predictor import GyroConfig, GyroPredictor
-from iemd_ros.pipeline.pipeline import ERROR, INIT_REASON, OK, WARN, FrameResult, PipelineConfig, TrackingPipeline
+from iemd_ros.gyro import GyroConfig, GyroPredictor
+from iemd_ros.pipeline import INIT_REASON, FrameResult, Level, PipelineConfig, Rejection, TrackingPipeline, TrackState
+
+OK, WARN, ERROR = Level.OK, Level.WARN, Level.ERROR
 from iemd_ros.datasets.synthetic import generate
-from iemd_ros.tracking.tracker import IemdTracker, TrackerConfig
+from iemd_ros.tracking import IemdTracker, TrackerConfig
 
 N = 24
 
@@ -60,7 +62,7 @@ def test_tracks_synthetic_shake_with_gyro_and_is_deterministic(seq):
         runs.append(_run(p, seq))
     res = runs[0]
     err = _centre_errors(res, seq)
-    assert all(r.state == "tracking" and r.gyro_used for r in res), [(r.state, r.gyro_reason) for r in res]
+    assert all(r.state is TrackState.TRACKING and r.gyro_used for r in res), [(r.state, r.gyro_reason) for r in res]
     assert err.max() < 6.0, err            # measured: max 0.3-0.8 px (320x240, 150 deg/s); 109 px without gyro
     assert all(0.0 < r.score <= 1.0 and r.score == pytest.approx(math.exp(-r.emd / 0.25)) for r in res)
     # the same messages give the same results (only the wall-clock timing differs)
@@ -91,7 +93,7 @@ def test_no_camera_info_tracks_without_prior_and_warns(seq):
     p.init(seq.frames[0], seq.gt_boxes[0], int(seq.frame_stamps_ns[0]))
     r = p.process(seq.frames[1], int(seq.frame_stamps_ns[1]))
     assert not r.gyro_used and "camera_info" in r.gyro_reason
-    status = {s.name.split(": ")[1]: s for s in p.statuses()}
+    status = {s.part.value: s for s in p.statuses()}
     assert status["camera_info"].level == WARN and "needs K" in status["camera_info"].message
     assert status["imu"].level == WARN and "without the gyro prior" in status["imu"].message
 
@@ -101,7 +103,7 @@ def test_gyro_integrates_from_the_last_frame_that_was_not_lost(seq):
     res = {k: p.process(seq.frames[k], stamps[k]) for k in range(1, 6)}
     noise = np.random.default_rng(0).integers(0, 256, seq.frames[6].shape, dtype=np.uint8)
     res[6] = p.process(noise, stamps[6])
-    assert res[6].state == "lost" and "EMD" in res[6].reason
+    assert res[6].state is TrackState.LOST and "EMD" in res[6].reason
     assert p.statuses()[0].level == WARN
     res[7] = p.process(seq.frames[7], stamps[7])
     ref = GyroPredictor(seq.camera, GyroConfig(time_offset_ns=seq.time_offset_ns))
@@ -110,7 +112,7 @@ def test_gyro_integrates_from_the_last_frame_that_was_not_lost(seq):
     wrong = ref.predict(stamps[6], stamps[7], box=res[5].box).box
     np.testing.assert_allclose(res[7].gyro_box, right, atol=1e-9)
     assert np.hypot(*(box_centre(right) - box_centre(wrong))) > 2.0
-    assert res[7].state == "tracking"
+    assert res[7].state is TrackState.TRACKING
 
 
 def test_imu_validation_counts_and_explains(seq):
@@ -177,13 +179,13 @@ def test_frame_stamps_going_back_are_rejected_or_reset(seq):
     p, s = _started(seq)
     assert p.process(seq.frames[2], s[2]).tracking
     r = p.process(seq.frames[1], s[1])
-    assert r.rejected.startswith("image stamp went back by 33.3 ms") and r.box is None
-    assert "repeats" in p.process(seq.frames[2], s[2]).rejected
+    assert r.rejection is Rejection.STAMP and r.reason.startswith("image stamp went back by 33.3 ms") and r.box is None
+    assert "repeats" in p.process(seq.frames[2], s[2]).reason
     assert p.diagnostics()["frames_rejected"] == 2
     assert p.statuses()[1].level == WARN
     # far back: clock reset, processed without a prior (nothing to integrate across the reset)
     r = p.process(seq.frames[3], s[3] - 10_000_000_000)
-    assert not r.rejected and not r.gyro_used and p.diagnostics()["clock_resets"] == 1
+    assert r.rejection is None and not r.gyro_used and p.diagnostics()["clock_resets"] == 1
 
 
 def test_gyro_ready_and_uninitialized_state(seq):
@@ -191,7 +193,7 @@ def test_gyro_ready_and_uninitialized_state(seq):
     p.set_camera(seq.camera)
     s = [int(v) for v in seq.frame_stamps_ns]
     r = p.process(seq.frames[0], s[0])
-    assert r.state == "uninitialized" and r.box is None and r.score == 0.0
+    assert r.state is TrackState.UNINITIALIZED and r.box is None and r.score == 0.0
     assert p.statuses()[0].level == WARN and "initial_box" in p.statuses()[0].message
     assert p.gyro_ready(s[1])                      # no target: nothing to wait for
     r = p.init(seq.frames[0], seq.gt_boxes[0], s[0])
@@ -203,7 +205,7 @@ def test_gyro_ready_and_uninitialized_state(seq):
     _feed_imu(p, seq)
     assert p.gyro_ready(s[2])
     p.reset()
-    assert p.state == "uninitialized" and p.diagnostics()["resets"] == 1
+    assert p.state is TrackState.UNINITIALIZED and p.diagnostics()["resets"] == 1
 
 
 def test_configure_validates_and_restarts_the_tracker(seq):
@@ -222,7 +224,7 @@ def test_configure_validates_and_restarts_the_tracker(seq):
     stored = p.diagnostics()["imu_stored"]
     new = PipelineConfig(tracker=TrackerConfig(n_particles=4), gyro=p.config.gyro)
     assert "restarted" in p.configure(new)
-    assert p.state == "tracking" and p.diagnostics()["imu_stored"] == stored
+    assert p.state is TrackState.TRACKING and p.diagnostics()["imu_stored"] == stored
     gyro2 = PipelineConfig(tracker=new.tracker, gyro=GyroConfig(time_offset_ns=seq.time_offset_ns, max_gap_ns=10**8))
     assert "rebuilt" in p.configure(gyro2) and p.diagnostics()["imu_stored"] == stored
     r2 = p.process(seq.frames[2], s[2])
@@ -259,14 +261,14 @@ def test_held_frames_are_tracked_counted_and_explained(seq, monkeypatch):
     monkeypatch.setattr(IemdTracker, "_confidence_check",
                         lambda self, center: (0.01, "models not updated: filter response 0.010 < 0.6 x ..."))
     results = [p.process(seq.frames[k], stamps[k]) for k in (2, 3)]
-    assert all(r.state == "tracking" and r.reason.startswith("models not updated") for r in results)
+    assert all(r.state is TrackState.TRACKING and r.reason.startswith("models not updated") for r in results)
     d = p.diagnostics()
     assert d["frames_held"] == 2 and d["frames_lost"] == 0 and d["frame_reason"].startswith("models not updated")
     assert p.statuses()[0].level == OK and p.statuses()[0].values["frames_held"] == "2"
 
 
 def test_frame_result_defaults():
-    r = FrameResult(5, "lost")
+    r = FrameResult(stamp_ns=5, state=TrackState.LOST)
     assert not r.tracking and math.isnan(r.emd) and r.as_dict()["stamp_ns"] == 5
 
 
@@ -274,7 +276,7 @@ def test_frame_result_is_init_marks_the_init_frame(seq):
     p, s = _started(seq)
     assert p.init(seq.frames[0], seq.gt_boxes[0], s[0]).is_init
     assert not p.process(seq.frames[1], s[1]).is_init
-    assert not FrameResult(5, "tracking", reason=INIT_REASON).is_init   # a flag set by init(), not read from the text
+    assert not FrameResult(stamp_ns=5, state=TrackState.TRACKING, reason=INIT_REASON).is_init   # a flag set by init(), not read from the text
 
 
 def test_config_from_yaml_reads_the_node_parameter_file_nested_or_dotted(tmp_path):
@@ -309,7 +311,7 @@ def test_config_from_yaml_reads_the_node_parameter_file_nested_or_dotted(tmp_pat
                         (node + "    tracker.n_iter: 3\n    tracker: 5\n", "tracker must be a group"),
                         ("iemd_tracker:\n  ros__parameters: [1, 2]\n", "ros__parameters must be a mapping"),
                         ("tracker: [1, 2]\n", "tracker must be a mapping"),
-                        (node + "    tracker.n_iter: abc\n", "invalid pipeline parameters"),
+                        (node + "    tracker.n_iter: abc\n", "tracker.n_iter must be a number"),
                         (node + "    use_gyro: 'no'\n", "use_gyro must be true or false"),
                         (node + "    use_gyro.x: 1\n", "use_gyro is a single parameter")]:
         (tmp_path / "bad.yaml").write_text(text)

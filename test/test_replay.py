@@ -18,7 +18,9 @@ from iemd_ros.bags.make import (_camera_info_msg, _compressed_msg, _image_msg, _
                                  write_bag, write_gt)
 from iemd_ros.common.cli import split_ros_args
 from iemd_ros.evaluation.metrics import iou, score_sequence
-from iemd_ros.bags.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, main, parse_box, replay
+from iemd_ros.apps.replay import main
+from iemd_ros.pipeline import Rejection
+from iemd_ros.bags.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, parse_box, replay
 
 N = 10
 BOTH_IMAGE_TYPES = "sensor_msgs/msg/Image or sensor_msgs/msg/CompressedImage"   # as the errors name them
@@ -248,12 +250,12 @@ def test_corrupt_compressed_frame_is_counted(seq, tmp_path):
     """A compressed frame that does not decode is treated as a malformed raw Image: a ``malformed`` row
     without a box, counted in the summary and the diagnostics, tracking goes on; the real process exits 0."""
     _bag_with(tmp_path / "cut", image_topics=(IMG_COMPRESSED,), seq=seq, bad_at=2, n=6)
-    out = run_module("iemd_ros.bags.replay", str(tmp_path / "cut"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"),
+    out = run_module("iemd_ros.apps.replay", str(tmp_path / "cut"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"),
                      "--out-bag", str(tmp_path / "res"))
     assert out.returncode == 0 and "Traceback" not in out.stderr, out.stderr
     assert f"6 images from {IMG}/compressed: gyro prior on 0 frames, lost on 0, rejected 1;" in out.stdout
     rows = read_csv_rows(tmp_path / "o.csv")[1:]
-    assert rows[2][1:] == ["", "", "", "", "", "malformed"]
+    assert rows[2][1:] == ["", "", "", "", "", "malformed", "0"]
     assert rows[0][6] == "init" and all(r[6] == "tracking" for r in rows[3:])
     image_input = [s for s in by_topic(read_all(tmp_path / "res"), DIAGNOSTICS_TOPIC)[2].status
                    if s.name.endswith("image input")][0]
@@ -306,7 +308,7 @@ def test_cli_process_no_traceback(seq, tmp_path):
     """The real process on a truncated bag: exit status 2, one stderr line, no traceback."""
     make_bag(seq, tmp_path / "m", count=3)
     _truncate(next((tmp_path / "m").glob("*.mcap")), 0.7)
-    out = run_module("iemd_ros.bags.replay", str(tmp_path / "m"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"))
+    out = run_module("iemd_ros.apps.replay", str(tmp_path / "m"), "--init", _init(seq), "--csv", str(tmp_path / "o.csv"))
     assert out.returncode == 2 and "Traceback" not in out.stderr and out.stderr.strip().count("\n") == 0
     assert "truncated or corrupt" in out.stderr
 
@@ -327,7 +329,7 @@ def test_first_images_malformed(seq, tmp_path, capsys):
     """As the node with initial_box: init on the first decodable image; none decodable -> exit 2."""
     _bag_with(tmp_path / "bad0", seq=seq, bad_at=0)
     res = replay(tmp_path / "bad0", seq.gt_boxes[1], warn=lambda s: None)
-    assert res.results[0].rejected.startswith("malformed") and res.results[1].stamp_ns == seq.frame_stamps_ns[1]
+    assert res.results[0].rejection is Rejection.MALFORMED and res.results[1].stamp_ns == seq.frame_stamps_ns[1]
     assert res.results[1].box == tuple(seq.gt_boxes[1])
     with BagWriter(tmp_path / "allbad", "mcap") as bag:
         bag.add_topic("/cam", "sensor_msgs/msg/Image")
@@ -340,7 +342,7 @@ def test_first_images_malformed(seq, tmp_path, capsys):
 def test_imu_wait_is_bag_time(seq, tmp_path):
     """A frame waits for the gyro at most imu_wait_ms of bag (log) time: an IMU logged 40 ms after its
     stamp is too late for the default 15 ms (no prior), in time for 100 ms (prior on every frame)."""
-    from iemd_ros.pipeline.pipeline import PipelineConfig
+    from iemd_ros.pipeline import PipelineConfig
 
     t_cam = seq.gyro_t_ns - seq.time_offset_ns
     events = [(int(t) + 40_000_000, 0, i) for i, t in enumerate(t_cam)]

@@ -11,6 +11,7 @@ from iemd_ros.common.boxes import box_centre
 from iemd_ros.evaluation.metrics import iou
 from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.template import TemplateDictionary
+from iemd_ros.tracking.analysis import descend, search_context
 from iemd_ros.tracking.tracker import MIN_SIDE_PX, _scale_bounds, _visible_fraction
 
 
@@ -44,8 +45,8 @@ def test_invalid_prior_and_call_order():
     tracker = IemdTracker()
     with pytest.raises(RuntimeError, match="before init"):
         tracker.update(frame)
-    with pytest.raises(RuntimeError, match="search_context.. called before init"):
-        tracker.search_context(ImagePyramid(to_gray(frame)))
+    with pytest.raises(RuntimeError, match="needs an initialized tracker"):
+        search_context(tracker, ImagePyramid(to_gray(frame)))
     tracker.init(frame, (100, 80, 40, 40))
     for prior, match in [(np.eye(2), "3x3"), (np.full((3, 3), np.nan), "non-finite"), (np.zeros((3, 3)), "singular")]:
         with pytest.raises(ValueError, match=match):
@@ -82,7 +83,7 @@ def test_recovers_a_translation_of_a_real_texture(car4_first):
 
 
 def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
-    """descend() converges from a start 3 px off on a shifted texture, and the next update() gives exactly
+    """analysis.descend() converges from a start 3 px off on a shifted texture, and the next update() gives exactly
     what a tracker that never descended gives."""
     frame0 = texture(seed=1, blob=8)
     box = (130.0, 90.0, 48.0, 40.0)
@@ -90,15 +91,15 @@ def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
     probed, untouched = IemdTracker(), IemdTracker()
     probed.init(frame0, box)
     untouched.init(frame0, box)
-    result = probed.descend(frame1, (box[0] + 2.4 - 3.0, box[1] - 1.7 + 1.0, 48.0, 40.0))
+    result = descend(probed, frame1, (box[0] + 2.4 - 3.0, box[1] - 1.7 + 1.0, 48.0, 40.0))
     assert abs(result.box[0] - (box[0] + 2.4)) < 0.5 and abs(result.box[1] - (box[1] - 1.7)) < 0.5, result.box
     assert result.box[2:] == (48.0, 40.0) and result.iterations > 0 and not result.lost
     assert result.codings == 1 + result.iterations  # the start and each trial step
     assert probed.update(frame1) == untouched.update(frame1)
-    with pytest.raises(RuntimeError, match="before init"):
-        IemdTracker().descend(frame1, box)
+    with pytest.raises(RuntimeError, match="needs an initialized tracker"):
+        descend(IemdTracker(), frame1, box)
     with pytest.raises(ValueError, match="outside"):
-        probed.descend(frame1, (-80.0, 10.0, 20.0, 20.0))
+        descend(probed, frame1, (-80.0, 10.0, 20.0, 20.0))
 
 
 def test_prior_moves_the_start_of_the_search():

@@ -23,7 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from iemd_ros.apps.replay import score_replay
 from iemd_ros.bags.make import source_from_synthetic, write_bag
+from iemd_ros.bags.replay import replay
 from iemd_ros.common.cli import CliParser, cli_main
 from iemd_ros.evaluation.metrics import OTB_THRESHOLDS, iou
 from iemd_ros.datasets.synthetic import SyntheticConfig, generate
@@ -44,8 +46,6 @@ def run_demo(out: Path = DEFAULT_OUT, n_frames: int = 90, seed: int = 1, max_rat
              progress: bool | None = None, log=print) -> dict:
     """Generate, write, replay twice, score, plot.  Returns ``{mode: (ReplayResult, SequenceScores)}``
     plus the paths under ``"paths"``."""
-    from iemd_ros.bags.replay import replay, score_replay
-
     if n_frames < 2:
         raise ValueError(f"--frames must be >= 2, got {n_frames}")
     out = Path(out)

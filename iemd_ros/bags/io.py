@@ -29,9 +29,8 @@ import numpy as np
 from iemd_ros.messages.conversions import ns_to_stamp, raw_twin
 from iemd_ros.common.cli import one_line
 
-__all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "DETECTIONS_TYPE",
-           "DIAGNOSTICS_TYPE", "FORMATS",
-           "BagError", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize",
+__all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "FORMATS",
+           "BagError", "BagMessages", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize",
            "header", "iter_messages", "open_bag", "resolve_bag_path", "ros1_typestore", "ros2_typestore",
            "select_topics"]
 
@@ -41,8 +40,6 @@ COMPRESSED_IMAGE_TYPE = "sensor_msgs/msg/CompressedImage"
 IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
 IMU_TYPE = "sensor_msgs/msg/Imu"
 CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
-DETECTIONS_TYPE = "vision_msgs/msg/Detection2DArray"
-DIAGNOSTICS_TYPE = "diagnostic_msgs/msg/DiagnosticArray"
 #: rosbag2 custom_data keys written by iemd-make-bag (documentation of the bag's provenance).
 META_PREFIX = "iemd_ros."
 
@@ -142,6 +139,20 @@ class BagWriter:
         ser = self.typestore.serialize_ros1 if self.ros1 else self.typestore.serialize_cdr
         self._writer.write(conn, int(log_time_ns), ser(message, conn.msgtype))
         self.counts[topic] += 1
+
+
+class BagMessages:
+    """A :class:`~iemd_ros.messages.outputs.MessageFactory` of a rosbag2 writer's typestore."""
+
+    def __init__(self, bag: BagWriter):
+        self._types = bag.typestore.types
+
+    def __call__(self, msgtype: str, **fields):
+        return self._types[msgtype](**fields)
+
+    @staticmethod
+    def byte(value: int) -> int:
+        return int(value)
 
 
 def header(bag: BagWriter, topic: str, stamp_ns: int, frame_id: str):

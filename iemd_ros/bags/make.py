@@ -42,9 +42,7 @@ sees the same, unambiguous message order.
 """
 from __future__ import annotations
 
-import argparse
 import csv
-import sys
 from dataclasses import dataclass
 from collections.abc import Callable
 from pathlib import Path
@@ -52,17 +50,16 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.bags.io import (CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, FORMATS, IMAGE_TYPE, IMU_TYPE, META_PREFIX,
-                     BagWriter, Progress, camera_info_fields, header)
-from iemd_ros.gyro.camera import CameraModel
-from iemd_ros.common.cli import CliParser, cli_main
-from iemd_ros.messages.conversions import (COMPRESSED_CODECS, JPEG_QUALITY, array_to_compressed_fields, check_compression,
-                          compressed_topic, is_compressed_topic)
+from iemd_ros.bags.io import (CAMERA_INFO_TYPE, COMPRESSED_IMAGE_TYPE, IMAGE_TYPE, IMU_TYPE, META_PREFIX, BagWriter,
+                              camera_info_fields, header)
 from iemd_ros.datasets.otb import IMAGE_SUFFIXES, is_sequence_folder, list_sequences, load_sequence, read_frame
-from iemd_ros.datasets.recordings import seconds_to_ns, load_recording
+from iemd_ros.datasets.recordings import load_recording, seconds_to_ns
+from iemd_ros.gyro import CameraModel
+from iemd_ros.messages.conversions import (JPEG_QUALITY, array_to_compressed_fields, check_compression,
+                                           compressed_topic, is_compressed_topic)
 
-__all__ = ["BagSource", "source_from_folder", "source_from_synthetic", "write_bag", "main",
-           "DEFAULT_TOPICS", "ENCODINGS"]
+__all__ = ["BagSource", "source_from_folder", "source_from_synthetic", "write_bag", "write_gt", "DEFAULT_TOPICS",
+           "ENCODINGS", "CAMERA_FRAME", "IMU_FRAME"]
 
 DEFAULT_TOPICS = dict(image="/camera/image_raw", camera_info="/camera/camera_info", imu="/imu/data")
 CAMERA_FRAME = "camera_optical_frame"
@@ -350,65 +347,3 @@ def write_gt(path, boxes: np.ndarray, flags=None) -> None:
         for k, b in enumerate(np.asarray(boxes, dtype=float)):
             row = [repr(float(v)) for v in (b[0] + 1, b[1] + 1, b[2], b[3])] if np.all(np.isfinite(b)) else ["NaN"] * 4
             wr.writerow(row + ([str(flags[k])] if flags is not None else []))
-
-
-# ---------------------------------------------------------------------------------------------- CLI
-def build_parser() -> argparse.ArgumentParser:
-    p = CliParser(prog="iemd-make-bag", description=__doc__.split("\n\n")[0],
-                  epilog="Stamps, clocks and frames: see `python -m pydoc iemd_ros.bags.make`.")
-    p.add_argument("source", type=Path, help="recording folder (CMU desk/aerial, phone), OTB sequence folder "
-                                             "or image folder")
-    p.add_argument("out", type=Path, help="output: rosbag2 folder (mcap/sqlite3) or FILE.bag (--format ros1)")
-    p.add_argument("--format", choices=FORMATS, default="mcap", help="bag format (default mcap)")
-    p.add_argument("--encoding", choices=ENCODINGS, default="bgr8", help="Image encoding (default bgr8)")
-    p.add_argument("--compress", choices=COMPRESSED_CODECS, default=None,
-                   help="write sensor_msgs/CompressedImage (image_transport format) on IMAGE_TOPIC/compressed "
-                        "instead of raw Image (default: raw)")
-    p.add_argument("--jpeg-quality", type=int, default=None, metavar="Q",
-                   help=f"JPEG quality 1..100 for --compress jpeg (default {JPEG_QUALITY})")
-    p.add_argument("--first", type=int, default=0, help="first frame (0-based, default 0)")
-    p.add_argument("--count", type=int, default=None, help="number of frames (default: to the end)")
-    p.add_argument("--imu-margin", type=float, default=0.5, metavar="S",
-                   help="keep IMU samples this many seconds around the frames (default 0.5)")
-    p.add_argument("--fps", type=float, default=None, help="frame rate for sources without stamps (default 30)")
-    p.add_argument("--stamps", type=Path, default=None, help="image folder: frame times in seconds, one per line")
-    p.add_argument("--imu-csv", type=Path, default=None, help="image folder: gyro log t_s,wx,wy,wz[,ax,ay,az]")
-    p.add_argument("--camera-yaml", type=Path, default=None, help="ROS camera_info YAML (overrides the source's)")
-    p.add_argument("--time-offset-ms", type=float, default=None,
-                   help="image folder: t_imu = t_cam + offset (Kalibr); the IMU stamps are shifted by -offset")
-    p.add_argument("--image-topic", default=DEFAULT_TOPICS["image"])
-    p.add_argument("--camera-info-topic", default=DEFAULT_TOPICS["camera_info"])
-    p.add_argument("--imu-topic", default=DEFAULT_TOPICS["imu"])
-    p.add_argument("--frame-id", default=CAMERA_FRAME, help=f"camera frame_id (default {CAMERA_FRAME})")
-    p.add_argument("--imu-frame-id", default=IMU_FRAME,
-                   help=f"IMU frame_id for --imu-csv (default {IMU_FRAME}); recordings with a camera-frame "
-                        "gyro use the camera frame_id")
-    p.add_argument("--gt-out", type=Path, default=None, help="also write the frames' ground truth (OTB text)")
-    return p
-
-
-def main(argv: list[str] | None = None) -> int:
-    def body() -> int:
-        a = build_parser().parse_args(argv)
-        src = source_from_folder(a.source, a.fps, a.stamps, a.imu_csv, a.camera_yaml, a.time_offset_ms,
-                                 a.imu_frame_id)
-        n = (len(src) - a.first) if a.count is None else a.count
-        bar = Progress(max(n, 0), "iemd-make-bag")
-        try:
-            info = write_bag(src, a.out, a.format, a.encoding, a.first, a.count, a.imu_margin,
-                             dict(image=a.image_topic, camera_info=a.camera_info_topic, imu=a.imu_topic),
-                             a.frame_id, a.gt_out, bar.update, a.compress, a.jpeg_quality)
-        finally:
-            bar.close()
-        print(f"iemd-make-bag: wrote {info['path']} ({info['format']}): {info['frames']} images "
-              f"{info['size'][0]}x{info['size'][1]} {a.encoding}{f' {a.compress}' if a.compress else ''} on "
-              f"{info['image_topic']}, {info['imu']} IMU samples "
-              f"(shifted {info['imu_time_shift_ns'] / 1e6:+.1f} ms onto the camera clock), camera info "
-              f"{'yes' if info['camera_info'] else 'no'}" + (f"; ground truth -> {a.gt_out}" if a.gt_out else ""))
-        return 0
-
-    return cli_main("iemd-make-bag", body)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

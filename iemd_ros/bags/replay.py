@@ -1,46 +1,27 @@
-"""``iemd-replay`` / ``ros2 run iemd_ros replay``: run the tracker over a bag offline, as fast as the CPU allows.
+"""Offline replay of a bag through the tracking pipeline, as fast as the CPU allows (``iemd-replay``).
 
-    iemd-replay BAG --init X,Y,W,H [--image-topic T] [--imu-topic T] [--camera-info-topic T] [--no-gyro]
-                --csv OUT.csv [--out-bag DIR] [--video OUT.mp4] [--gt FILE] [--config YAML]
-                [--camera-yaml FILE] [--time-offset-ms MS] [--progress | --no-progress]
+``BAG``: a rosbag2 folder (sqlite3 or mcap) or a ROS 1 ``.bag`` file (rosbags' AnyReader).  The image, IMU and
+camera-info topics are auto-detected when the bag has one of each type, else named
+(:func:`iemd_ros.bags.io.select_topics`).  The messages go, in the bag's (log-time) order, through
+:class:`~iemd_ros.pipeline.TrackingPipeline` -- the same synchronization, gyro prediction and tracker as the node --
+deterministically: nothing depends on the wall clock, so the same bag gives the same CSV byte for byte.
 
-``BAG``: a rosbag2 folder (sqlite3 or mcap) or a ROS 1 ``.bag`` file (rosbags' AnyReader).  The image,
-IMU and camera-info topics are auto-detected when the bag has one of each type, else named.  Images are
-``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage`` (jpeg/png, e.g. ``image_raw/compressed``); a
-compressed topic is left out when its own raw twin (``image_raw`` for ``image_raw/compressed``) holds
-messages (:func:`iemd_ros.bags.io.select_topics`).  The messages go, in
-the bag's (log-time) order, through :class:`iemd_ros.pipeline.pipeline.TrackingPipeline` -- the same
-synchronization, gyro prediction and tracker as the node -- deterministically: nothing depends on the
-wall clock, so the same bag gives the same CSV byte for byte.
+IMU synchronization is the node's :class:`~iemd_ros.pipeline.ImuWait` on the bag's log times: a frame is held until
+the gyro covers it or until ``imu_wait_ms`` of bag time has passed after it (a message logged later than that is
+applied after the frame).  This is what the node does with the bag played at 1x when its processing keeps up; the
+live node may in addition drop frames that arrive while it is busy, the offline replay never drops.
 
-IMU synchronization: a frame is held until the gyro covers it (:meth:`TrackingPipeline.gyro_ready`)
-or until ``imu_wait_ms`` (pipeline config, default 15 ms) of *bag* time has passed after it (a message
-logged later than that is applied after the frame), then processed (without the prior if the gyro
-still does not cover it).  As in the node, an Imu with ``angular_velocity_covariance[0] = -1`` carries no
-rate and is rejected.  This is what the node does with the bag played at 1x when its processing keeps
-up (the node waits ``imu_wait_ms`` of wall time); the live node may in addition drop frames that
-arrive while it is busy, the offline replay never drops.
-The gyro time offset ``t_d`` is ``gyro.time_offset_ns`` of the config (default 0: bags made by
-``iemd-make-bag`` already carry IMU stamps on the camera clock).
+The tracker starts from ``init_box`` (0-based pixels, top-left + size) on the first image that can be decoded, as
+the node does with its ``initial_box``.
 
-The tracker is initialised with ``--init`` (0-based pixels, top-left + size) on the first image that
-can be decoded, as the node does with its ``initial_box``.
-
-Outputs: the CSV (``stamp_ns,x,y,w,h,emd,state``, one row per image, floats in shortest round-trip
-form; the init frame's row holds the init box with state ``init`` and an empty emd; a frame the
-pipeline could not use has an empty box and state ``rejected``/``malformed`` (an image that does not
-convert or decode: counted, tracking goes on)); optionally a rosbag2 (mcap) with
-``vision_msgs/Detection2DArray`` and ``diagnostic_msgs/DiagnosticArray`` stamped and logged like the
-images (open it in Foxglove next to the input), an annotated MP4 (``mp4v``), and with ``--gt`` (OTB
-``x,y,w,h`` or the desk ``x,y,w,h,flag`` format, one line per image, 1-based) the metrics of
-:mod:`iemd_ros.evaluation.ope`.
-
-Bad input (missing/truncated bag, no images, a topic of the wrong type, an init box outside the image,
-...) prints one line on stderr and exits with status 2.
+Outputs: the CSV (:data:`CSV_HEADER`, one row per image, floats in shortest round-trip form; the init frame's row
+holds the init box with state ``init`` and an empty emd; a frame the pipeline could not use has an empty box and
+state ``rejected``/``malformed``; ``held`` is 1 on a tracked frame whose models did not learn), optionally a rosbag2
+(mcap) with ``vision_msgs/Detection2DArray`` and ``diagnostic_msgs/DiagnosticArray`` stamped and logged like the
+images (open it in Foxglove next to the input), and an annotated MP4 (``mp4v``).
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import math
 import sys
@@ -52,29 +33,30 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.bags.io import (DETECTIONS_TYPE, DIAGNOSTICS_TYPE, BagError, BagWriter, Progress, Topics, deserialize, header,
-                     iter_messages, open_bag, select_topics)
+from iemd_ros.bags.io import BagError, BagMessages, BagWriter, Progress, Topics, deserialize, iter_messages, \
+    open_bag, select_topics
 from iemd_ros.common.boxes import check_box
-from iemd_ros.gyro.camera import CameraModel
-from iemd_ros.common.cli import CliParser, cli_main, split_ros_args
-from iemd_ros.messages.conversions import (CLASS_ID, DETECTION_ID, camera_model_from_msg, detection_values, image_from_msg,
-                          imu_sample, stamp_ns)
+from iemd_ros.gyro import CameraModel
+from iemd_ros.messages.conversions import CLASS_ID, DETECTION_ID, camera_model_from_msg, image_from_msg, \
+    imu_sample, stamp_ns
+from iemd_ros.messages.outputs import DETECTIONS_TYPE, DIAGNOSTICS_TYPE, detection_array, diagnostic_array, header
+from iemd_ros.pipeline import FrameResult, ImuWait, PipelineConfig, TrackingPipeline, TrackState
 from iemd_ros.pipeline.drawing import draw_result
-from iemd_ros.pipeline.pipeline import FrameResult, PipelineConfig, TrackingPipeline
 
-__all__ = ["ReplayResult", "replay", "parse_box", "load_gt", "write_csv", "CSV_HEADER", "main"]
+__all__ = ["Replay", "ReplayResult", "replay", "parse_box", "write_csv", "CSV_HEADER", "DETECTIONS_TOPIC",
+           "DIAGNOSTICS_TOPIC"]
 
-CSV_HEADER = ("stamp_ns", "x", "y", "w", "h", "emd", "state")
-# as the node publishes them (iemd_ros.ros.node defaults: ``detections`` in the root namespace, class_id
-# "target", id "iemd"; one detection while tracking, none when lost; the init frame has score 1)
+CSV_HEADER = ("stamp_ns", "x", "y", "w", "h", "emd", "state", "held")
+# as the node publishes them (``detections`` in the root namespace, class_id "target", id "iemd")
 DETECTIONS_TOPIC = "/detections"
 DIAGNOSTICS_TOPIC = "/diagnostics"
+HARDWARE_ID = "iemd_replay"
 
 
 @dataclass
 class ReplayResult:
-    """Per-image results (the init frame's has ``is_init``; frames skipped with
-    ``drop_stamps`` have none) and run statistics."""
+    """Per-image results (the init frame's has ``is_init``; frames skipped with ``drop_stamps`` have none) and run
+    statistics."""
 
     bag: str
     topics: Topics
@@ -119,28 +101,22 @@ def parse_box(box) -> tuple[float, float, float, float]:
     return check_box(box.split(",") if isinstance(box, str) else box, "--init", shown=box)
 
 
-def load_gt(path) -> np.ndarray:
-    """Ground truth (N, 4), 0-based: OTB ``x,y,w,h`` lines or the desk ``x,y,w,h,flag`` lines."""
-    from iemd_ros.datasets.otb import parse_groundtruth
-
-    return parse_groundtruth(path, with_flags=True)[0]
-
-
 def _fmt(v) -> str:
     return "" if v is None or (isinstance(v, float) and math.isnan(v)) else repr(float(v))
 
 
 def csv_rows(results: list[FrameResult]):
+    """The CSV rows of :data:`CSV_HEADER` of ``results``."""
     for r in results:
         box = r.box if r.box is not None else (None,) * 4
         if r.is_init:
             state = "init"
-        elif r.rejected:
-            state = "malformed" if r.rejected.startswith("malformed") else "rejected"
+        elif r.rejection is not None:
+            state = r.rejection.value
         else:
-            state = r.state
-        emd = None if r.is_init or r.rejected else r.emd
-        yield [str(int(r.stamp_ns)), *(_fmt(v) for v in box), _fmt(emd), state]
+            state = r.state.value
+        emd = None if r.is_init or r.rejection is not None else r.emd
+        yield [str(int(r.stamp_ns)), *(_fmt(v) for v in box), _fmt(emd), state, str(int(r.held))]
 
 
 def write_csv(path, results: list[FrameResult]) -> None:
@@ -161,34 +137,14 @@ class _OutBag:
         self.bag.__enter__()
         self.bag.add_topic(DETECTIONS_TOPIC, DETECTIONS_TYPE)
         self.bag.add_topic(DIAGNOSTICS_TOPIC, DIAGNOSTICS_TYPE)
+        self.make = BagMessages(self.bag)
 
     def write(self, log_t: int, frame_id: str, r: FrameResult, statuses) -> None:
-        """The frame's Detection2DArray (one detection while ``r`` is tracking, else empty) and statuses."""
-        b = self.bag
-        M = b.msg
-        hdr = header(b, DETECTIONS_TOPIC, r.stamp_ns, frame_id)
-        dets = []
-        values = detection_values(r)
-        if values is not None:
-            cx, cy, sx, sy = values.bbox
-            hyp = M("vision_msgs/msg/ObjectHypothesisWithPose")(
-                hypothesis=M("vision_msgs/msg/ObjectHypothesis")(class_id=CLASS_ID, score=values.score),
-                pose=M("geometry_msgs/msg/PoseWithCovariance")(
-                    pose=M("geometry_msgs/msg/Pose")(
-                        position=M("geometry_msgs/msg/Point")(x=0.0, y=0.0, z=0.0),
-                        orientation=M("geometry_msgs/msg/Quaternion")(x=0.0, y=0.0, z=0.0, w=1.0)),
-                    covariance=np.zeros(36)))
-            bbox = M("vision_msgs/msg/BoundingBox2D")(
-                center=M("vision_msgs/msg/Pose2D")(position=M("vision_msgs/msg/Point2D")(x=cx, y=cy), theta=0.0),
-                size_x=sx, size_y=sy)
-            dets.append(M("vision_msgs/msg/Detection2D")(header=hdr, results=[hyp], bbox=bbox, id=DETECTION_ID))
-        b.write(DETECTIONS_TOPIC, log_t, M(DETECTIONS_TYPE)(header=hdr, detections=dets))
-        status = [M("diagnostic_msgs/msg/DiagnosticStatus")(
-            level=s.level, name=s.name, message=s.message, hardware_id="iemd_replay",
-            values=[M("diagnostic_msgs/msg/KeyValue")(key=str(k), value=str(v)) for k, v in s.values.items()])
-            for s in statuses]
-        b.write(DIAGNOSTICS_TOPIC, log_t,
-                M(DIAGNOSTICS_TYPE)(header=header(b, DIAGNOSTICS_TOPIC, r.stamp_ns, frame_id), status=status))
+        """The frame's Detection2DArray (one detection while ``r`` is tracking, else empty) and its statuses."""
+        hdr = header(self.make, r.stamp_ns, frame_id)
+        self.bag.write(DETECTIONS_TOPIC, log_t, detection_array(self.make, hdr, r, CLASS_ID, DETECTION_ID))
+        rows = [(s.name("iemd_tracker"), s.level, s.message, s.values) for s in statuses]
+        self.bag.write(DIAGNOSTICS_TOPIC, log_t, diagnostic_array(self.make, hdr, rows, HARDWARE_ID))
 
     def close(self, exc_type=None) -> None:
         self.bag.__exit__(exc_type, None, None)
@@ -240,236 +196,185 @@ class _Frame:
     error: str = ""
 
 
-def replay(bag, init_box, *, image_topic: str | None = None, imu_topic: str | None = None,
-           camera_info_topic: str | None = None, config: PipelineConfig | None = None, use_gyro: bool = True,
-           camera: CameraModel | None = None, csv_path=None, out_bag=None, video=None, progress: bool | None = None,
-           warn=None, drop_stamps=()) -> ReplayResult:
-    """Replay ``bag`` through :class:`TrackingPipeline`, initialised with ``init_box`` on the first image
-    (``"X,Y,W,H"`` or 4 numbers, checked by :func:`parse_box`).
+class Replay:
+    """One offline run of a bag through :class:`~iemd_ros.pipeline.TrackingPipeline` (see the module docstring).
 
-    ``config``: pipeline configuration (default ``PipelineConfig()``); ``use_gyro=False`` disables the
-    prior (``--no-gyro``).  ``camera``: calibration to use instead of the bag's camera info.
-    ``warn(text)`` receives the warnings (default: printed to stderr).  ``drop_stamps``: images with
-    these stamps are skipped and counted as dropped (``TrackingPipeline.note_dropped``), as the live node
-    does with frames that arrive while it is busy -- to reproduce a live run offline.  Raises ValueError (BagError)
-    on bad input; partial output files are removed then.
+    Parameters
+    ----------
+    bag : path
+        rosbag2 folder (or its ``metadata.yaml`` / storage file) or ROS 1 ``.bag``.
+    init_box : str or sequence of 4 float
+        ``"X,Y,W,H"`` or 4 numbers (:func:`parse_box`): the target on the first decodable image.
+    image_topic, imu_topic, camera_info_topic : str, optional
+        Topics to use (default: the bag's one topic of each type).
+    config : PipelineConfig, optional
+        Default ``PipelineConfig()``; ``use_gyro=False`` disables the prior (``--no-gyro``).
+    camera : CameraModel, optional
+        Calibration to use instead of the bag's camera info.
+    warn : callable, optional
+        Receives the warnings (default: printed to stderr).
+    drop_stamps : iterable of int
+        Images with these stamps are skipped and counted as dropped (``TrackingPipeline.note_dropped``), as the
+        live node does with frames that arrive while it is busy: a live run reproduced offline.
+
+    Raises
+    ------
+    ValueError
+        (:class:`~iemd_ros.bags.io.BagError`) on bad input: a missing or truncated bag, no images, a topic of the
+        wrong type, an init box outside the image.
     """
-    warn = warn if warn is not None else (lambda s: print(f"iemd-replay: warning: {s}", file=sys.stderr))
-    init_box = parse_box(init_box)
-    cfg = config if config is not None else PipelineConfig()
-    warnings: list[str] = []
 
-    def note(text: str) -> None:
-        warnings.append(text)
-        warn(text)
+    def __init__(self, bag, init_box, *, image_topic: str | None = None, imu_topic: str | None = None,
+                 camera_info_topic: str | None = None, config: PipelineConfig | None = None, use_gyro: bool = True,
+                 camera: CameraModel | None = None, warn=None, drop_stamps=()):
+        self.bag = bag
+        self.init_box = parse_box(init_box)
+        self._warn = warn if warn is not None else (lambda s: print(f"iemd-replay: warning: {s}", file=sys.stderr))
+        self.warnings: list[str] = []
+        self._camera = camera
+        self._drop = {int(t) for t in drop_stamps}
+        self._reader = open_bag(bag)
+        try:
+            self.topics = select_topics(self._reader, image_topic, imu_topic, camera_info_topic)
+            cfg = config if config is not None else PipelineConfig()
+            self.use_gyro = self._gyro_usable(bool(use_gyro and cfg.use_gyro))
+            self.pipeline = TrackingPipeline(replace(cfg, use_gyro=self.use_gyro), camera)
+        except BaseException:
+            self._reader.close()
+            raise
+        self._wait = ImuWait(self.pipeline)
+        self._n_imu = self._reader.topics[self.topics.imu].msgcount if self.use_gyro else 0
 
-    reader = open_bag(bag)
-    outputs: list = []
-    try:
-        topics = select_topics(reader, image_topic, imu_topic, camera_info_topic)
-        use = bool(use_gyro and cfg.use_gyro)
-        if use and topics.imu is None:
-            note("the bag has no sensor_msgs/msg/Imu topic: replaying without the gyro prior")
-            use = False
-        elif use and topics.camera_info is None and camera is None:
-            note("the bag has no sensor_msgs/msg/CameraInfo topic (the gyro prior needs K): "
-                 "replaying without the gyro prior")
-            use = False
-        cfg = replace(cfg, use_gyro=use)
-        pipe = TrackingPipeline(cfg, camera)
-        wanted = {topics.image} | ({topics.imu} if use else set()) | \
-                 ({topics.camera_info} if use and camera is None and topics.camera_info else set())
-        conns = [c for c in reader.connections if c.topic in wanted]
-        n_images = reader.topics[topics.image].msgcount
-        n_imu = reader.topics[topics.imu].msgcount if use else 0
-        wait_ns = int(round(cfg.imu_wait_ms * 1e6))
-        bar = Progress(n_images, "iemd-replay", progress)
-        results: list[FrameResult] = []
-        pending: deque[_Frame] = deque()
-        out = _OutBag(out_bag, topics.image) if out_bag is not None else None
-        if out is not None:
-            outputs.append(out)
-        vid = None
-        imu_seen = 0
-        drop = {int(t) for t in drop_stamps}
-        dropped: list[int] = []
-        init_s = [0.0]
+    def _gyro_usable(self, wanted: bool) -> bool:
+        if wanted and self.topics.imu is None:
+            self._note("the bag has no sensor_msgs/msg/Imu topic: replaying without the gyro prior")
+            return False
+        if wanted and self.topics.camera_info is None and self._camera is None:
+            self._note("the bag has no sensor_msgs/msg/CameraInfo topic (the gyro prior needs K): "
+                       "replaying without the gyro prior")
+            return False
+        return wanted
+
+    def _note(self, text: str) -> None:
+        self.warnings.append(text)
+        self._warn(text)
+
+    def run(self, csv_path=None, out_bag=None, video=None, progress: bool | None = None) -> ReplayResult:
+        """Replay the whole bag, writing the outputs asked for (partial output files are removed on an error)."""
+        self._results: list[FrameResult] = []
+        self._dropped: list[int] = []
+        self._pending: deque[_Frame] = deque()
+        self._imu_seen, self._init_s = 0, 0.0
+        self._bar = Progress(self._reader.topics[self.topics.image].msgcount, "iemd-replay", progress)
+        self._out = _OutBag(out_bag, self.topics.image) if out_bag is not None else None
+        self._video = _Video(video) if video is not None else None
         t_start = time.perf_counter()
-
-        def emit(f: _Frame, r: FrameResult) -> None:
-            nonlocal vid
-            results.append(r)
-            if out is not None:
-                out.write(f.log_t, f.frame_id, r, pipe.statuses())
-            if video is not None and f.image is not None:
-                if vid is None:
-                    vid = _Video(video)
-                    outputs.append(vid)
-                vid.write(f.image, r)
-            bar.update(1, f"{r.state}")
-
-        def process(f: _Frame) -> None:
-            if pipe.state != "uninitialized" and f.stamp in drop:
-                pipe.note_dropped(f.stamp)
-                dropped.append(f.stamp)
-                return
-            if f.error:
-                pipe.note_bad_image(f.error, f.stamp)
-                emit(f, FrameResult(f.stamp, pipe.state, rejected=f"malformed: {f.error}"))
-            elif pipe.state == "uninitialized":    # first decodable image: initialise (as the node)
-                t0 = time.perf_counter()
-                try:
-                    r = pipe.init(f.image, init_box, f.stamp)
-                except ValueError as exc:
-                    raise ValueError(f"--init {','.join(f'{v:g}' for v in init_box)}: {exc}") from None
-                init_s[0] = time.perf_counter() - t0
-                emit(f, r)
-            else:
-                emit(f, pipe.process(f.image, f.stamp))
-
-        def ready(f: _Frame) -> bool:
-            return (bool(f.error) or pipe.state == "uninitialized" or imu_seen >= n_imu
-                    or pipe.gyro_ready(f.stamp))
-
-        def flush(now_log: int | None, arrived: bool) -> None:
-            """Process the held frames that can go: ready, or -- before the message logged at
-            ``now_log`` is applied (``arrived`` False) -- whose IMU wait ended earlier; all at the end."""
-            while pending:
-                f = pending[0]
-                if not (now_log is None or ready(f) or (not arrived and now_log > f.log_t + wait_ns)):
-                    return
-                pending.popleft()
-                process(f)
-
-        for conn, log_t, raw in iter_messages(reader, conns, bag):
-            flush(log_t, arrived=False)          # frames the node would have given up waiting for
-            msg = deserialize(reader, raw, conn.msgtype, bag)
-            if conn.topic == topics.image:
-                stamp = stamp_ns(msg.header)
-                try:
-                    img = image_from_msg(msg)
-                    pending.append(_Frame(log_t, stamp, msg.header.frame_id, img))
-                except ValueError as exc:
-                    pending.append(_Frame(log_t, stamp, msg.header.frame_id, None, str(exc)))
-            elif conn.topic == topics.imu:
-                imu_seen += 1
-                pipe.add_imu_message(*imu_sample(msg))
-            else:
-                try:
-                    pipe.set_camera(camera_model_from_msg(msg))
-                except ValueError as exc:
-                    pipe.note_bad_camera_info(str(exc))
-            flush(log_t, arrived=True)
-        flush(None, arrived=True)
-        bar.close()
-        wall = time.perf_counter() - t_start
-        if pipe.state == "uninitialized" and not dropped:
-            raise BagError(f"no image on {topics.image!r} of {bag} could be decoded: "
-                           f"{results[0].rejected if results else 'the topic is empty'}")
-        if use and pipe.counters["camera_infos"] == 0 and camera is None:
-            note("no usable camera info in the bag: tracked without the gyro prior")
-        if csv_path is not None:
-            write_csv(csv_path, results)
-        for o in outputs:
-            o.close()
-        outputs.clear()
-        return ReplayResult(str(bag), topics, results, wall,
-                            sum(r.processing_ms for r in results) / 1e3, warnings, pipe.diagnostics(), dropped,
-                            init_s[0])
-    except BaseException as exc:
-        for o in outputs:
-            if isinstance(o, _OutBag):
-                o.close(type(exc))
-            else:
-                o.close()
+        try:
+            self._feed()
+            self._bar.close()
+            wall = time.perf_counter() - t_start
+            if self.pipeline.state is TrackState.UNINITIALIZED and not self._dropped:
+                first = self._results[0].reason if self._results else "the topic is empty"
+                raise BagError(f"no image on {self.topics.image!r} of {self.bag} could be decoded: {first}")
+            if self.use_gyro and self.pipeline.counters["camera_infos"] == 0 and self._camera is None:
+                self._note("no usable camera info in the bag: tracked without the gyro prior")
+            if csv_path is not None:
+                write_csv(csv_path, self._results)
+            self._close_outputs(None)
+        except BaseException as exc:
+            self._close_outputs(type(exc))
+            if video is not None:
                 Path(video).unlink(missing_ok=True)
-        raise
-    finally:
-        reader.close()
+            raise
+        finally:
+            self._reader.close()
+        return ReplayResult(str(self.bag), self.topics, self._results, wall,
+                            sum(r.processing_ms for r in self._results) / 1e3, self.warnings,
+                            self.pipeline.diagnostics(), self._dropped, self._init_s)
+
+    def _close_outputs(self, exc_type) -> None:
+        if self._out is not None:
+            self._out.close(exc_type)
+            self._out = None
+        if self._video is not None:
+            self._video.close()
+            self._video = None
+
+    def _feed(self) -> None:
+        """Every message in log-time order; before each, the held frames whose IMU wait ended earlier go."""
+        t = self.topics
+        wanted = {t.image} | ({t.imu} if self.use_gyro else set()) | \
+                 ({t.camera_info} if self.use_gyro and self._camera is None and t.camera_info else set())
+        conns = [c for c in self._reader.connections if c.topic in wanted]
+        for conn, log_t, raw in iter_messages(self._reader, conns, self.bag):
+            self._release(log_t)
+            msg = deserialize(self._reader, raw, conn.msgtype, self.bag)
+            if conn.topic == t.image:
+                self._pending.append(self._frame(log_t, msg))
+            elif conn.topic == t.imu:
+                self._imu_seen += 1
+                self.pipeline.add_imu_message(*imu_sample(msg))
+            else:
+                try:
+                    self.pipeline.set_camera(camera_model_from_msg(msg))
+                except ValueError as exc:
+                    self.pipeline.note_bad_camera_info(str(exc))
+            self._release(None)
+        while self._pending:
+            self._process(self._pending.popleft())
+
+    @staticmethod
+    def _frame(log_t: int, msg) -> _Frame:
+        stamp = stamp_ns(msg.header)
+        try:
+            return _Frame(log_t, stamp, msg.header.frame_id, image_from_msg(msg))
+        except ValueError as exc:
+            return _Frame(log_t, stamp, msg.header.frame_id, None, str(exc))
+
+    def _release(self, now_log: int | None) -> None:
+        """Process the held frames, in order, that may go: ready, or (``now_log``: before the message logged then is
+        applied) waited out by then."""
+        while self._pending:
+            f = self._pending[0]
+            if not (self._ready(f) or (now_log is not None and self._wait.waited_out(f.log_t, now_log))):
+                return
+            self._process(self._pending.popleft())
+
+    def _ready(self, f: _Frame) -> bool:
+        """Nothing is lost by processing ``f`` now: it is malformed, no target yet, no IMU will come, or the gyro
+        covers it."""
+        return (bool(f.error) or self.pipeline.state is TrackState.UNINITIALIZED or self._imu_seen >= self._n_imu
+                or self._wait.ready(f.stamp))
+
+    def _process(self, f: _Frame) -> None:
+        pipe = self.pipeline
+        if pipe.state is not TrackState.UNINITIALIZED and f.stamp in self._drop:
+            pipe.note_dropped(f.stamp)
+            self._dropped.append(f.stamp)
+            return
+        if f.error:
+            self._emit(f, pipe.note_bad_image(f.error, f.stamp))
+        elif pipe.state is TrackState.UNINITIALIZED:  # first decodable image: initialize (as the node)
+            t0 = time.perf_counter()
+            try:
+                result = pipe.init(f.image, self.init_box, f.stamp)
+            except ValueError as exc:
+                raise ValueError(f"--init {','.join(f'{v:g}' for v in self.init_box)}: {exc}") from None
+            self._init_s = time.perf_counter() - t0
+            self._emit(f, result)
+        else:
+            self._emit(f, pipe.process(f.image, f.stamp))
+
+    def _emit(self, f: _Frame, r: FrameResult) -> None:
+        self._results.append(r)
+        if self._out is not None:
+            self._out.write(f.log_t, f.frame_id, r, self.pipeline.statuses())
+        if self._video is not None and f.image is not None:
+            self._video.write(f.image, r)
+        self._bar.update(1, r.state.value)
 
 
-# ---------------------------------------------------------------------------------------------- CLI
-def score_replay(result: ReplayResult, gt: np.ndarray, name: str):
-    """The tracker evaluation's scores (:class:`iemd_ros.evaluation.metrics.SequenceScores`) of a replay against ``gt``;
-    fps counts the tracker's processing time only."""
-    from iemd_ros.evaluation.metrics import score_sequence
-
-    boxes = result.boxes
-    if len(gt) != len(boxes):
-        raise ValueError(f"the ground truth has {len(gt)} boxes for {len(boxes)} images in the bag")
-    fps = len(boxes) / result.track_s if result.track_s > 0 else math.inf
-    return score_sequence(boxes, gt, name, fps=fps)
-
-
-def evaluation_table(result: ReplayResult, gt: np.ndarray, name: str, label: str = "iemd") -> tuple[str, object]:
-    """Scores of the replay against ``gt`` and the table of :func:`iemd_ros.evaluation.ope.format_table`."""
-    from iemd_ros.evaluation.ope import MEAN, format_table, mean_scores
-
-    scores = score_replay(result, gt, name)
-    table = format_table({label: {name: scores.to_dict(), MEAN: mean_scores([scores])}}, [label], [name])
-    return table, scores
-
-
-def build_parser() -> argparse.ArgumentParser:
-    p = CliParser(prog="iemd-replay", description=__doc__.split("\n\n")[0],
-                  epilog="Details: python -m pydoc iemd_ros.bags.replay")
-    p.add_argument("bag", help="rosbag2 folder (sqlite3/mcap) or ROS 1 .bag file")
-    p.add_argument("--init", required=True, type=str, metavar="X,Y,W,H",
-                   help="initial box on the first image (0-based pixels, top-left + size)")
-    p.add_argument("--image-topic", default=None, help="sensor_msgs/Image or CompressedImage topic (default: the "
-                                                        "bag's one image topic; X/compressed yields to its raw X)")
-    p.add_argument("--imu-topic", default=None)
-    p.add_argument("--camera-info-topic", default=None)
-    p.add_argument("--no-gyro", action="store_true", help="track without the gyro prior")
-    p.add_argument("--csv", required=True, type=Path, help="per-image results (stamp_ns,x,y,w,h,emd,state)")
-    p.add_argument("--out-bag", type=Path, default=None,
-                   help="write detections + diagnostics into this new rosbag2 (mcap) folder")
-    p.add_argument("--video", type=Path, default=None, help="write an annotated MP4 (mp4v)")
-    p.add_argument("--gt", type=Path, default=None, help="ground truth (OTB or desk format): print the metrics")
-    p.add_argument("--config", type=Path, default=None,
-                   help="pipeline configuration: the node's parameter file (config/tracker.yaml) or "
-                        "{tracker: {...}, gyro: {...}, imu_wait_ms: ...}")
-    p.add_argument("--camera-yaml", type=Path, default=None,
-                   help="ROS camera_info YAML to use instead of the bag's camera info")
-    p.add_argument("--time-offset-ms", type=float, default=None,
-                   help="gyro time offset t_d (t_imu = t_cam + t_d); default from --config, else 0")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="progress bar on stderr (default: when stderr is a terminal)")
-    return p
-
-
-def main(argv: list[str] | None = None) -> int:
-    def body() -> int:
-        args, _ = split_ros_args(argv)      # from `ros2 run` / launch: the replay has no ROS arguments
-        a = build_parser().parse_args(args)
-        box = parse_box(a.init)
-        cfg = PipelineConfig.from_yaml(a.config) if a.config else PipelineConfig()
-        if a.time_offset_ms is not None:
-            cfg = replace(cfg, gyro=replace(cfg.gyro, time_offset_ns=int(round(a.time_offset_ms * 1e6))))
-        camera = CameraModel.from_yaml(a.camera_yaml) if a.camera_yaml else None
-        gt = load_gt(a.gt) if a.gt else None
-        if a.out_bag is not None and a.out_bag.exists():
-            raise ValueError(f"--out-bag {a.out_bag} exists already; choose a new folder")
-        res = replay(a.bag, box, image_topic=a.image_topic, imu_topic=a.imu_topic,
-                     camera_info_topic=a.camera_info_topic, config=cfg, use_gyro=not a.no_gyro, camera=camera,
-                     csv_path=a.csv, out_bag=a.out_bag, video=a.video, progress=a.progress)
-        d = res.diagnostics
-        n = len(res.results)
-        print(f"iemd-replay: {n} images from {res.topics.image}"
-              f"{f', IMU {res.topics.imu}' if res.topics.imu else ''}: gyro prior on {res.gyro_used} frames, "
-              f"lost on {d.get('frames_lost', 0)}, rejected {d.get('frames_rejected', 0) + d.get('images_malformed', 0)}; "
-              f"{res.wall_s:.1f} s wall for {res.duration_s:.1f} s of bag = {res.realtime_factor:.2f}x real time")
-        print(f"iemd-replay: results -> {a.csv}" + (f", {a.out_bag}" if a.out_bag else "")
-              + (f", {a.video}" if a.video else ""))
-        if gt is not None:
-            table, _ = evaluation_table(res, gt, Path(a.bag).name.removesuffix(".bag")[:14],
-                                        "iemd" if a.no_gyro else "iemd+g")
-            print()
-            print(table)
-        return 0
-
-    return cli_main("iemd-replay", body)
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+def replay(bag, init_box, *, csv_path=None, out_bag=None, video=None, progress: bool | None = None,
+           **options) -> ReplayResult:
+    """``Replay(bag, init_box, **options).run(csv_path, out_bag, video, progress)``."""
+    return Replay(bag, init_box, **options).run(csv_path, out_bag, video, progress)

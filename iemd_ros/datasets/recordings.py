@@ -22,14 +22,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.gyro.camera import CameraModel
-from iemd_ros.gyro.predictor import GyroConfig, GyroPredictor
 from iemd_ros.datasets.otb import parse_groundtruth
-from iemd_ros.pipeline.pipeline import FrameResult, PipelineConfig, TrackingPipeline
-from iemd_ros.tracking.tracker import TrackerConfig
+from iemd_ros.gyro import CameraModel, GyroConfig, GyroPredictor
 
-__all__ = ["Recording", "load_recording", "load_cmu", "load_phone", "track_recording",
-           "CMU_TIME_OFFSET_NS"]
+__all__ = ["Recording", "load_recording", "load_cmu", "load_phone", "seconds_to_ns", "CMU_TIME_OFFSET_NS"]
 
 #: The authors' ``Time_offset -20`` (ms): ``t_imu = t_file - 20 ms``.
 CMU_TIME_OFFSET_NS = -20_000_000
@@ -169,29 +165,3 @@ def load_recording(path) -> Recording:
     if (root / "derived_gyro_camframe.csv").exists():
         return load_phone(root)
     raise ValueError(f"{root}: neither a CMU recording (*_img.log) nor the phone one (derived_gyro_camframe.csv)")
-
-
-def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True,
-                    config: TrackerConfig | None = None) -> tuple[list[FrameResult], list[str]]:
-    """Track frames ``start+1 .. stop-1`` of ``rec`` from its GT box at ``start``, causally.
-
-    The frames and the whole gyro record go through a :class:`~iemd_ros.pipeline.pipeline.TrackingPipeline`,
-    so the priors are the node's: with ``use_gyro`` the prior for frame k is the lens-aware local
-    homography at the tracker's window, integrated from the frame that window belongs to (after a
-    frame reported lost the tracker keeps its previous window), and a prior the tracker refuses is
-    dropped for that frame.  Returns the results and one note per frame tracked without a gyro prior.
-    """
-    cfg = PipelineConfig(tracker=config if config is not None else TrackerConfig(), gyro=rec.gyro_config(),
-                         use_gyro=use_gyro)
-    pipe = TrackingPipeline(cfg, camera=rec.camera)
-    if use_gyro:                                   # as the node gets them: one message at a time
-        for t, w in zip(rec.imu_t_ns, rec.gyro):
-            pipe.add_imu(int(t), w)
-    pipe.init(rec.load_frame(start), rec.gt_boxes[start], int(rec.frame_stamps_ns[start]))
-    results, no_prior = [], []
-    for k in range(start + 1, stop):
-        res = pipe.process(rec.load_frame(k), int(rec.frame_stamps_ns[k]))
-        results.append(res)
-        if use_gyro and not res.gyro_used:
-            no_prior.append(f"frame {k}: {res.gyro_reason}")
-    return results, no_prior

@@ -26,9 +26,7 @@ Usage::
 """
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,11 +35,9 @@ from typing import Callable, Protocol
 import cv2
 import numpy as np
 
-from iemd_ros.common.cli import CliParser, cli_main
 from iemd_ros.evaluation.metrics import OTB_THRESHOLDS, PRECISION_THRESHOLD, SequenceScores, score_sequence, valid_boxes
 from iemd_ros.datasets.otb import Sequence, default_root, is_sequence_folder, list_sequences, load_sequence
-from iemd_ros.pipeline.pipeline import PipelineConfig
-from iemd_ros.tracking.tracker import IemdTracker, TrackerConfig
+from iemd_ros.tracking import IemdTracker, TrackerConfig
 
 DEFAULT_TRACKERS = ("iemd", "csrt", "kcf")
 DEFAULT_OUT = Path("out") / "eval"
@@ -218,40 +214,6 @@ def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
     return "\n".join(lines)
 
 
-def _csv(text: str) -> list[str]:
-    items = [t.strip() for t in text.split(",") if t.strip()]
-    if not items:
-        raise argparse.ArgumentTypeError(f"empty list {text!r}")
-    return items
-
-
-def _positive_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
-    if v < 2:
-        raise argparse.ArgumentTypeError(f"must be >= 2 (init frame + at least one update), got {v}")
-    return v
-
-
-def build_parser() -> argparse.ArgumentParser:
-    p = CliParser(prog="iemd-eval", description=__doc__.split("\n\n")[0],
-                formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("inputs", nargs="*", metavar="ROOT_OR_SEQ",
-                   help="OTB root folder(s) and/or sequence folder(s); default ../shared/data/otb")
-    p.add_argument("--trackers", type=_csv, default=list(DEFAULT_TRACKERS),
-                   help=f"comma-separated, from {','.join(TRACKERS)} (default: all)")
-    p.add_argument("--sequences", type=_csv, default=None,
-                   help="comma-separated sequence names (Jogging selects Jogging-1 and Jogging-2)")
-    p.add_argument("--max-frames", type=_positive_int, default=None, help="evaluate only the first N frames")
-    p.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output folder (default out/eval)")
-    p.add_argument("--config", type=Path, default=None,
-                   help="iEMD parameters: the node's parameter file (config/tracker.yaml) or {tracker: {...}}; "
-                        "its tracker.* values apply (OTB has no IMU)")
-    return p
-
-
 def collect_sequences(inputs: list[str], wanted: list[str] | None) -> list[Sequence]:
     """Load the sequences named by the CLI inputs (OTB roots, sequence folders or ``<folder>-<k>``
     targets), keeping those in ``wanted`` (case-insensitive; ``Jogging`` selects Jogging-1 and -2)."""
@@ -359,31 +321,3 @@ def _json_default(obj):
     if isinstance(obj, np.generic):
         return obj.item()
     raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
-
-
-def main(argv: list[str] | None = None) -> int:
-    def body() -> int:
-        args = build_parser().parse_args(argv)
-        trackers = list(dict.fromkeys(args.trackers))
-        for t in trackers:
-            make_tracker(t)  # fail early on an unknown tracker or one this OpenCV build lacks
-        if args.config and "iemd" not in trackers:
-            raise ValueError("--config sets the iemd tracker's parameters, but iemd is not among --trackers")
-        configs = {"iemd": PipelineConfig.from_yaml(args.config).tracker} if args.config else {}
-        sequences = collect_sequences(args.inputs, args.sequences)
-        if args.max_frames is not None:
-            sequences = [s.head(args.max_frames) for s in sequences]
-        t_start = time.perf_counter()
-        print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) -> {args.out}"
-              + (f" (iEMD parameters from {args.config})" if args.config else ""))
-        doc = evaluate(sequences, trackers, args.out, configs=configs)  # unreadable image, unwritable --out: one line, exit 2
-        print()
-        print(format_table(doc["results"], trackers, doc["sequences"]))
-        print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}")
-        return 0
-
-    return cli_main("iemd-eval", body)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -32,14 +32,14 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from iemd_ros.tracking.appearance import grey_levels
 from iemd_ros.common.boxes import centre_box, check_box, map_points
 from iemd_ros.gyro.camera import CameraModel
 from iemd_ros.gyro.imu import ACCEPTED_STATUS, Coverage, ImuBuffer, ImuIntegration
+from iemd_ros.gyro.config import GyroConfig
 from iemd_ros.gyro.rotation import GyroCalibration, StillBiasEstimator
 
 __all__ = ["rotation_homography", "warp_points", "box_grid", "local_prior", "predict_box",
-           "warp_difference", "GyroConfig", "GyroPrediction", "GyroPredictor"]
+           "warp_difference", "GyroPrediction", "GyroPredictor", "warm_up"]
 
 
 def rotation_homography(K, R, K_inv=None) -> np.ndarray:
@@ -139,7 +139,7 @@ def warp_difference(frame_prev, frame_cur, H, valid=None, erode: int = 5) -> flo
     an optional boolean mask of defined pixels (e.g. after undistortion), shared by both frames.  Only
     pixels defined in both (eroded by ``erode`` px against interpolation at the borders) count.
     """
-    a, b = (grey_levels(np.asarray(f)) for f in (frame_prev, frame_cur))
+    a, b = (cv2.cvtColor(f, cv2.COLOR_BGR2GRAY) if f.ndim == 3 else f for f in map(np.asarray, (frame_prev, frame_cur)))
     if a.shape != b.shape:
         raise ValueError(f"frames differ in size: {a.shape} vs {b.shape}")
     h, w = a.shape
@@ -152,36 +152,6 @@ def warp_difference(frame_prev, frame_cur, H, valid=None, erode: int = 5) -> flo
     if not m.any():
         raise ValueError("the warped frame does not overlap the current one")
     return float(np.abs(warped - b.astype(np.float32))[m.astype(bool)].mean())
-
-
-@dataclass
-class GyroConfig:
-    """Extrinsic, bias, time offset and buffer settings of :class:`GyroPredictor`.
-
-    ``time_offset_ns``: Kalibr's shift, ``t_imu = t_cam + time_offset_ns``.
-    ``R_cam_imu``/``bias``: ``w_cam = R_cam_imu (w_imu - bias)``.
-    ``still_bias_samples``: if > 0, estimate the bias from the first N samples when their per-axis
-    std is below ``still_bias_max_std`` (rad/s); it then replaces ``bias``.
-    ``allow_gaps``: use a rotation integrated across a gap > ``max_gap_ns`` (else no prior).
-    Checked when built (ValueError): extrinsic and bias, buffer limits, still-bias settings.
-    """
-
-    time_offset_ns: int = 0
-    R_cam_imu: np.ndarray | None = None
-    bias: np.ndarray | None = None
-    still_bias_samples: int = 0
-    still_bias_max_std: float = 0.02
-    saturation: float | None = None
-    max_gap_ns: int = 50_000_000
-    buffer_ns: int = 10_000_000_000
-    buffer_samples: int = 20_000
-    allow_gaps: bool = False
-    coning: bool = True
-
-    def __post_init__(self):
-        GyroCalibration.checked(self.R_cam_imu, self.bias)
-        ImuBuffer.check_settings(self.buffer_ns, self.buffer_samples, self.saturation, self.max_gap_ns)
-        StillBiasEstimator.check_settings(self.still_bias_samples, self.still_bias_max_std)
 
 
 @dataclass(frozen=True)
@@ -230,8 +200,8 @@ class GyroPredictor:
             raise ValueError(f"camera must be a CameraModel or None, got {type(camera).__name__}")
         self.camera = camera
         self.config = cfg = config if config is not None else GyroConfig()
-        self._cal = GyroCalibration(cfg.R_cam_imu, cfg.bias)
-        self.buffer = ImuBuffer(cfg.buffer_ns, cfg.buffer_samples, cfg.saturation, cfg.max_gap_ns)
+        self._cal = GyroCalibration(cfg.rotation, cfg.bias)
+        self.buffer = ImuBuffer(cfg.buffer_ns, cfg.buffer_samples, cfg.saturation_limit, cfg.max_gap_ns)
         self.bias_estimator = StillBiasEstimator(cfg.still_bias_samples, cfg.still_bias_max_std)
 
     @property
@@ -284,7 +254,7 @@ class GyroPredictor:
         return GyroPrediction(integ, integ.R, H, prior, pbox, integ.reason, res)
 
 
-def compile_gyro_jit() -> None:
+def warm_up() -> None:
     """JIT-compile the gyro path's numba kernels now (or load them from numba's on-disk cache):
     the IMU screening, the window integration and the lens model.  In a fresh environment the first
     IMU message and gyro prediction otherwise stall for seconds (4.5 s measured on a cold cache);

@@ -4,7 +4,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from iemd_ros.pipeline.pipeline import FrameResult
+from iemd_ros.pipeline.results import FrameResult
 
 __all__ = ["draw_result"]
 
@@ -29,9 +29,9 @@ def draw_result(frame: np.ndarray, r: FrameResult) -> np.ndarray:
 def _status(r: FrameResult) -> str:
     if r.is_init:
         return "initialized"
-    if r.rejected or r.box is None:
-        return r.rejected or r.state
-    return (f"{r.state} EMD {r.emd:.4f} it {r.iterations} {'gyro' if r.gyro_used else 'no gyro'} "
+    if r.rejection is not None or r.box is None:
+        return r.reason or r.state.value
+    return (f"{r.state.value}{' (held)' if r.held else ''} EMD {r.emd:.4f} it {r.iterations} {'gyro' if r.gyro_used else 'no gyro'} "
             f"{r.processing_ms:.0f} ms")
 
 

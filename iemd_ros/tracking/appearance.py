@@ -20,12 +20,8 @@ import numpy as np
 
 
 def to_gray(frame: np.ndarray) -> np.ndarray:
-    """Grey levels in [0, 1] (float32) of an HxW or HxWx3 (BGR) uint8 frame.
-
-    The paper's appearance vectors are "normalized pixel values" without saying which channels.
-    Patches of all three BGR channels (a 3mn-vector each, normalized together) were measured at
-    27.7 % mean average overlap over the 12 OTB sequences against 31.9 % for grey levels.
-    """
+    """Grey levels in [0, 1] (float32) of an HxW or HxWx3 (BGR) uint8 frame: the paper's "normalized pixel
+    values" are grey levels (docs/decisions.md#grey-patches-template-size)."""
     return np.multiply(grey_levels(frame), np.float32(1.0 / 255.0), dtype=np.float32)
 
 
@@ -74,16 +70,13 @@ class ImagePyramid:
             self._levels.append(cv2.pyrDown(self._levels[-1]))
         return self._levels[index]
 
-    def sample(self, center, size, template_size, coarse: int = 0, angle: float = 0.0) -> np.ndarray:
+    def sample(self, center, size, template_size, angle: float = 0.0) -> np.ndarray:
         """Resample a window to a (Th, Tw) template; ``template_size`` is (Tw, Th).
 
-        ``coarse`` samples that many pyramid levels above the anti-aliasing level:
-        a smoother template of the same window, for the coarse stage of the
-        search.  ``angle`` (radians) rotates the window about its centre: its x
-        axis points along (cos, sin) in the image.  Parts outside the image are
-        padded by replicating the border.
+        ``angle`` (radians) rotates the window about its centre: its x axis points along (cos, sin) in the
+        image.  Parts outside the image are padded by replicating the border.
         """
-        level, linear, centre = self._geometry(center, size, template_size, coarse, angle)
+        level, linear, centre = self._geometry(center, size, template_size, angle)
         return warp_window(self.level(level), centre, linear, template_size)
 
     def sample_scales(self, center, size, template_size, factors, angle: float = 0.0) -> np.ndarray:
@@ -91,7 +84,7 @@ class ImagePyramid:
         (len(factors), Th, Tw), in one remap from the anti-aliasing level of the unscaled window (the same
         smoothing at every scale, so the templates differ by their scale only)."""
         tw, th = template_size
-        level, linear, centre = self._geometry(center, size, template_size, 0, angle)
+        level, linear, centre = self._geometry(center, size, template_size, angle)
         grid = np.stack(np.meshgrid(np.arange(tw) - (tw - 1) / 2, np.arange(th) - (th - 1) / 2))  # (2, Th, Tw)
         offsets = np.einsum("ij,jhw->ihw", linear, grid)  # image offset of each template pixel at scale 1
         factors = np.asarray(factors, dtype=np.float64)
@@ -100,11 +93,11 @@ class ImagePyramid:
         out = cv2.remap(self.level(level), maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
         return out.reshape(len(factors), int(th), int(tw))
 
-    def _geometry(self, center, size, template_size, coarse: int, angle: float):
+    def _geometry(self, center, size, template_size, angle: float):
         """(pyramid level, linear map of template pixels to that level's pixels, window centre there)."""
         tw, th = template_size
         sx, sy = size[0] / tw, size[1] / th
-        level = int(np.floor(np.log2(max(min(sx, sy), 1.0)))) + coarse
+        level = int(np.floor(np.log2(max(min(sx, sy), 1.0))))
         level = min(max(level, 0), self.n_levels - 1)
         f = 2.0**level
         # Image point of template pixel u: c + R(angle) ((u - (T-1)/2) * s); at level l
@@ -120,19 +113,13 @@ class PatchLayout:
     template_size: tuple[int, int]  # (Tw, Th)
     patch_size: tuple[int, int]  # (m, n) = (width, height)
     step: int
-    normalization: str = "patch"  # "patch", "window" or "l2": see extract()
-    # Grey-level std below which a window/patch counts as flat.  12 OTB sequences, mean average
-    # overlap: 0.005 27.5 %, 0.01 25.1 %, 0.02 31.9 %, 0.04 19.4 % (Car4's dark car under the bridge
-    # is the low-contrast case; no value keeps it).
-    min_contrast: float = 0.02
+    min_contrast: float = 0.02  # grey-level std below which a patch counts as flat (docs/decisions.md#patch-normalization)
 
     def __post_init__(self):
         tw, th = self.template_size
         pw, ph = self.patch_size
         if pw > tw or ph > th or self.step < 1:
             raise ValueError(f"patches {self.patch_size} step {self.step} do not fit a template {self.template_size}")
-        if self.normalization not in ("window", "patch", "l2"):
-            raise ValueError(f"unknown patch normalization {self.normalization!r}")
 
     @property
     def cells(self) -> tuple[int, int]:
@@ -159,48 +146,27 @@ class PatchLayout:
         return positions
 
     def extract(self, template: np.ndarray) -> np.ndarray:
-        """(N, m*n) appearance vectors epsilon ("normalized pixel values").
+        """(N, m*n) appearance vectors epsilon, the paper's "normalized pixel values" (section 4).
 
-        Normalization (``normalization``):
-        - "patch" (default): each patch to zero mean and unit norm, invariant to
-          local brightness and contrast; a patch whose standard deviation is below
-          ``min_contrast`` is scaled as if it had that contrast (shorter vector);
-        - "window": the whole window to zero mean and unit standard deviation,
-          each patch keeping its pixels (divided by sqrt(m n));
-        - "l2": raw grey levels scaled to unit norm (all vectors lie in a narrow
-          cone of positive vectors, so appearance barely separates patches).
-        Measured with benchmarks/tune_tracker.py --discrimination (share of
-        off-target windows with a lower EMD than the ground truth, Car4/Bolt2/
-        Woman, lower is better): patch 17.6 %, window 32.1 %, l2 42.5 %.
+        Each patch is brought to zero mean and unit norm, invariant to local brightness and contrast; a patch
+        whose standard deviation is below ``min_contrast`` is scaled as if it had that contrast (a shorter
+        vector), so flat patches do not amplify noise (docs/decisions.md#patch-normalization).
         """
         return self.extract_with_jacobian(template, jacobian=False)[0]
 
     def extract_with_jacobian(self, template: np.ndarray, jacobian: bool = True):
         """epsilon (N, d) and its derivative (N, d, 2) with respect to moving the window.
 
-        The derivative is per template pixel of window motion (x, y): the patch
-        pixels' grey-level gradients (central differences of the template) pushed
-        through the normalization.  In "window" mode the window statistics are
-        treated as constant (they change far more slowly than the pixels).
+        The derivative is per template pixel of window motion (x, y): the patch pixels' grey-level gradients
+        (central differences of the template) pushed through the normalization.
         """
         template = np.asarray(template, dtype=np.float64)
         if template.shape != self.template_size[::-1]:
             raise ValueError(f"template of shape {template.shape} does not match {self.template_size[::-1]}")
         pw, ph = self.patch_size
-        if self.normalization == "window":
-            scale = 1.0 / (max(template.std(), self.min_contrast) * np.sqrt(pw * ph))
-            eps = (self._patches(template) - template.mean()) * scale
-            if not jacobian:
-                return eps, None
-            gx, gy = _gradient(template)
-            return eps, np.stack([self._patches(gx), self._patches(gy)], axis=-1) * scale
-        if self.normalization == "patch":
-            center, floor = True, self.min_contrast * np.sqrt(pw * ph)
-        else:
-            center, floor = False, 1e-6
+        floor = self.min_contrast * np.sqrt(pw * ph)
         gx, gy = _gradient(template) if jacobian else (template, template)
-        eps, jac = _unit_patches(template.ravel(), gx.ravel(), gy.ravel(), self._patch_index, center, floor,
-                                 jacobian)
+        eps, jac = _unit_patches(template.ravel(), gx.ravel(), gy.ravel(), self._patch_index, floor, jacobian)
         return eps, (jac if jacobian else None)
 
     @cached_property
@@ -226,19 +192,17 @@ def _patch_mean(flat, pixels):
 
 
 @numba.njit(cache=True)
-def _unit_patches(flat, gx, gy, index, center, floor, jacobian):
-    """Patches of a flat template scaled to unit norm (zero mean first if ``center``), and their Jacobian.
+def _unit_patches(flat, gx, gy, index, floor, jacobian):
+    """Patches of a flat template brought to zero mean and unit norm, and their Jacobian.
 
-    eps = p / max(||p||, floor); above the floor d eps = (I - eps eps') dp / ||p||,
-    below it dp / floor, with dp the patch of the grey-level gradients (also
-    zero-mean if ``center``).  One pass per patch instead of ~30 numpy calls
-    on (49, 64) arrays (0.4 ms -> 0.02 ms per window).
+    eps = p / max(||p||, floor); above the floor d eps = (I - eps eps') dp / ||p||, below it dp / floor, with dp
+    the zero-mean patch of the grey-level gradients; one pass per patch.
     """
     n, d = index.shape
     eps = np.empty((n, d))
     jac = np.zeros((n, d, 2)) if jacobian else np.zeros((0, d, 2))
     for i in range(n):
-        mean = _patch_mean(flat, index[i]) if center else 0.0
+        mean = _patch_mean(flat, index[i])
         norm = 0.0
         for j in range(d):
             eps[i, j] = flat[index[i, j]] - mean
@@ -251,7 +215,7 @@ def _unit_patches(flat, gx, gy, index, center, floor, jacobian):
             continue
         for k in range(2):
             g = gx if k == 0 else gy
-            gmean = _patch_mean(g, index[i]) if center else 0.0
+            gmean = _patch_mean(g, index[i])
             dot = 0.0
             for j in range(d):
                 jac[i, j, k] = g[index[i, j]] - gmean

@@ -25,7 +25,7 @@ import numba
 import numpy as np
 
 from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout
-from iemd_ros.tracking.emd import EmdSolution, appearance_distance, emd_gradient, envelope_gradient, solve_emd
+from iemd_ros.tracking.emd import EmdSolution, appearance_distance, emd_gradient, solve_emd
 from iemd_ros.tracking.histogram import candidate_weights, target_weights
 from iemd_ros.tracking.template import TemplateDictionary
 
@@ -62,12 +62,11 @@ class TargetModel:
 class SearchContext:
     """What the candidate windows of one search on one frame are sampled from and compared against.
 
-    The windows are resampled from ``pyramid`` ``coarse`` levels above its anti-aliasing level,
-    turned by ``angle`` (see ImagePyramid.sample; positions and gradients are in the window's own
-    axes), and cut into patches by ``layout``.  ``dictionary`` codes the patches
-    (:meth:`TemplateDictionary.code_weights`); None (the coarse stage) gives every patch code weight
-    1: only the kernel weights bins.  ``alpha`` weighs appearance against space in the ground
-    distance; ``bandwidth`` is the kernel's h.
+    The windows are resampled from ``pyramid`` turned by ``angle`` (see ImagePyramid.sample; positions and
+    gradients are in the window's own axes) and cut into patches by ``layout``.  ``dictionary`` codes the patches
+    (:meth:`TemplateDictionary.code_weights`); None gives every patch code weight 1, so that only the kernel
+    weights bins.  ``alpha`` weighs appearance against space in the ground distance; ``bandwidth`` is the
+    kernel's h.
     """
 
     pyramid: ImagePyramid
@@ -76,7 +75,6 @@ class SearchContext:
     dictionary: TemplateDictionary | None
     alpha: float
     bandwidth: float
-    coarse: int = 0
     angle: float = 0.0
 
 
@@ -88,8 +86,7 @@ class CandidateModel:
         self.center = np.asarray(center, dtype=np.float64)
         self.size = np.asarray(size, dtype=np.float64)
         layout, target, dictionary = context.layout, context.target, context.dictionary
-        self.template = context.pyramid.sample(self.center, self.size, layout.template_size, context.coarse,
-                                               context.angle)
+        self.template = context.pyramid.sample(self.center, self.size, layout.template_size, context.angle)
         self.eps = layout.extract(self.template)
         self.pos = layout.positions()
         self.code_weights = np.ones(len(self.eps)) if dictionary is None else dictionary.code_weights(self.eps)
@@ -97,17 +94,12 @@ class CandidateModel:
         self._solved = None  # (y, kept bins, dw_C/dy of them, EmdSolution) of the last emd()
 
     @property
-    def coarse(self) -> int:
-        """Pyramid levels above the anti-aliasing level the window was sampled at."""
-        return self.context.coarse
-
-    @property
     def angle(self) -> float:
         """The window's orientation in the image (radians)."""
         return self.context.angle
 
     def at(self, center, size=None) -> "CandidateModel":
-        """The model in the same context (frame, target, dictionary, pyramid level, orientation) at another window:
+        """The model in the same context (frame, target, dictionary, orientation) at another window:
         Algorithm 1's next iterate, or a scale variant when ``size`` is given."""
         return CandidateModel(self.context, center, self.size if size is None else size)
 
@@ -151,8 +143,6 @@ class CandidateModel:
         """dEMD/dy (2,) per normalized unit at the last :meth:`emd`'s offset.  ``kind``:
 
         - "paper": eq. (10), the duals times dw_C/dy (patches fixed, kernel moves);
-        - "envelope": the same model with the spatial ground distance moving too,
-          sum_uv f_uv dd_uv/dy + sum_v v_v dw_C,v/dy;
         - "appearance": the derivative of the re-sampled model that Algorithm 1
           evaluates (only at y = 0): when the window moves its patches are
           re-sampled, so d_uv changes through epsilon_v(y); with the flow fixed
@@ -165,9 +155,6 @@ class CandidateModel:
         y, keep, dw_dy, solution = self._solved
         if kind == "paper":
             return emd_gradient(solution, dw_dy)
-        if kind == "envelope":
-            diff = self.context.target.pos[:, None, :] - (self.pos[keep] - y)[None, :, :]
-            return envelope_gradient(solution, dw_dy, 2.0 * (1.0 - self.context.alpha) * diff)
         if kind == "appearance":
             if np.any(y != 0):
                 raise ValueError("the appearance gradient is defined at the model's own position (y = 0)")

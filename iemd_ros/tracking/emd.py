@@ -101,13 +101,3 @@ def _check_problem(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray) -> None:
 def emd_gradient(solution: EmdSolution, dw_c_dy: np.ndarray) -> np.ndarray:
     """The paper's eq. (10): dD*/dy = sum_v v_v dw_C,v/dy, with dw_c_dy of shape (N_C, 2)."""
     return solution.v @ dw_c_dy
-
-
-def envelope_gradient(solution: EmdSolution, dw_c_dy: np.ndarray, dcost_dy: np.ndarray) -> np.ndarray:
-    """Full derivative of D* when the ground distance depends on y too.
-
-    By the envelope theorem for the LP, the optimal flow and duals stay fixed to
-    first order, so dD*/dy = sum_uv f_uv dd_uv/dy + sum_v v_v dw_C,v/dy.
-    ``dcost_dy`` has shape (N_T, N_C, 2).
-    """
-    return np.einsum("uv,uvk->k", solution.flow, dcost_dy) + emd_gradient(solution, dw_c_dy)

@@ -17,16 +17,12 @@ log time of each message, for nodes with ``use_sim_time``.
 """
 from __future__ import annotations
 
-import argparse
-import importlib
-import sys
 import time
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from iemd_ros.bags.io import BagError, Progress, iter_messages, open_bag, ros2_typestore
-from iemd_ros.common.cli import CliParser, cli_main, split_ros_args
 from iemd_ros.messages.conversions import ns_to_stamp
+from iemd_ros.ros.messages import message_class
 
 
 @dataclass
@@ -40,15 +36,6 @@ class PlayStats:
     mean_late_ms: float = 0.0
 
 
-def message_class(msgtype: str):
-    """rclpy message class of ``pkg/msg/Name`` (from the installed message package)."""
-    pkg, kind, name = msgtype.split("/")
-    try:
-        return getattr(importlib.import_module(f"{pkg}.{kind}"), name)
-    except (ImportError, AttributeError):
-        raise BagError(f"message type {msgtype} is not installed for rclpy (package {pkg})") from None
-
-
 def _cdr_converter(reader, msgtype: str, cache: dict, dst_typestore):
     """bytes of the bag -> ROS 2 CDR bytes (identity for rosbag2, rosbags' converter for ROS 1)."""
     if reader.is2:
@@ -60,7 +47,8 @@ def _cdr_converter(reader, msgtype: str, cache: dict, dst_typestore):
     return lambda raw: bytes(conv(raw))
 
 
-def _parse_remaps(remaps) -> dict:
+def parse_remaps(remaps) -> dict:
+    """``FROM:=TO`` texts -> {FROM: TO}; ValueError for any other text."""
     out = {}
     for r in remaps or []:
         src, sep, dst = r.partition(":=")
@@ -167,38 +155,3 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
                 node.destroy_publisher(pub)
         if own_init:
             rclpy.try_shutdown()
-
-
-def build_parser() -> argparse.ArgumentParser:
-    p = CliParser(prog="iemd-play", description=__doc__.split("\n\n")[0])
-    p.add_argument("bag", type=Path, help="rosbag2 folder (sqlite3/mcap) or ROS 1 .bag file")
-    p.add_argument("--rate", type=float, default=1.0, help="playback rate factor (default 1.0)")
-    p.add_argument("--topics", nargs="+", default=None, help="play only these topics")
-    p.add_argument("--remap", action="append", default=[], metavar="FROM:=TO", help="publish FROM under TO")
-    p.add_argument("--delay", type=float, default=0.0, metavar="S", help="sleep S seconds before playing")
-    p.add_argument("--wait-subscribers", type=float, default=0.0, metavar="S",
-                   help="wait up to S seconds until every topic has a subscriber")
-    p.add_argument("--clock", action="store_true", help="also publish /clock with the log times")
-    p.add_argument("--qos-depth", type=int, default=100, help="publisher queue depth (default 100)")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="progress bar on stderr (default: when stderr is a terminal)")
-    return p
-
-
-def main(argv: list[str] | None = None) -> int:
-    def body() -> int:
-        args, ros_args = split_ros_args(argv)
-        a = build_parser().parse_args(args)
-        stats = play(a.bag, a.rate, a.topics, _parse_remaps(a.remap), a.delay, a.wait_subscribers, a.clock,
-                     a.qos_depth, progress=a.progress, ros_args=ros_args)
-        n = sum(stats.published.values())
-        print(f"iemd-play: published {n} messages on {len(stats.published)} topics: {stats.bag_s:.2f} s of bag in "
-              f"{stats.wall_s:.2f} s wall (rate {a.rate:g}); late by {stats.mean_late_ms:.2f} ms on average, "
-              f"{stats.max_late_ms:.1f} ms at most")
-        return 0
-
-    return cli_main("iemd-play", body)
-
-
-if __name__ == "__main__":
-    sys.exit(main())

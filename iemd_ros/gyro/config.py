@@ -1,0 +1,77 @@
+"""The gyro prior's parameters (:class:`GyroConfig`): extrinsic, bias, time offset, IMU buffer."""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from iemd_ros.common.params import coerce, param
+from iemd_ros.gyro.imu import ImuBuffer
+from iemd_ros.gyro.rotation import GyroCalibration, StillBiasEstimator
+
+__all__ = ["GyroConfig"]
+
+IDENTITY = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
+
+
+@dataclass
+class GyroConfig:
+    """Parameters of :class:`~iemd_ros.gyro.predictor.GyroPredictor`; ``w_cam = R_cam_imu (w_imu - bias)`` and
+    ``t_imu = t_cam + time_offset_ns``.  ``R_cam_imu`` may be given as a 3x3 array, ``bias`` as an array."""
+
+    time_offset_ns: int = param(0, "camera-IMU time offset, t_imu = t_cam + offset (Kalibr's timeshift_cam_imu)",
+                                unit="ns", range=(-1e9, 1e9), decision="gyro-time-offset")
+    R_cam_imu: tuple[float, ...] = param(IDENTITY, "IMU -> camera rotation, 9 values row-major", length=9,
+                                         range=(-1.0, 1.0), eq="eq. (22)")
+    bias: tuple[float, ...] = param((0.0, 0.0, 0.0), "gyro bias [x, y, z] in the IMU frame", unit="rad/s", length=3,
+                                    range=(-10.0, 10.0))
+    still_bias_samples: int = param(0, "estimate the bias from the first N samples if the camera is still (0: off)",
+                                    range=(0, 100_000))
+    still_bias_max_std: float = param(0.02, "largest per-axis standard deviation of a still start", unit="rad/s",
+                                      range=(1e-6, 1.0))
+    saturation: float = param(0.0, "reject samples with |w_i| >= this (0: no limit)", unit="rad/s",
+                              range=(0.0, 1000.0))
+    max_gap_ns: int = param(50_000_000, "IMU sample spacing reported as a gap", unit="ns", range=(1e6, 1e10))
+    buffer_ns: int = param(10_000_000_000, "IMU history kept", unit="ns", range=(1e8, 1e14))
+    buffer_samples: int = param(20_000, "IMU samples kept at most", range=(2, 1e8))
+    allow_gaps: bool = param(False, "use a rotation integrated across a gap (else no prior)")
+    coning: bool = param(True, "coning correction of the rotation integration", decision="imu-integration")
+
+    def __post_init__(self):
+        if self.R_cam_imu is None:
+            self.R_cam_imu = IDENTITY
+        if self.bias is None:
+            self.bias = (0.0, 0.0, 0.0)
+        if self.saturation is None:
+            self.saturation = 0.0
+        if isinstance(self.R_cam_imu, np.ndarray):
+            self.R_cam_imu = self.R_cam_imu.ravel()
+        coerce(self, "gyro.")
+        try:
+            GyroCalibration.checked(self.rotation, self.bias)
+            ImuBuffer.check_settings(self.buffer_ns, self.buffer_samples, self.saturation_limit, self.max_gap_ns)
+            StillBiasEstimator.check_settings(self.still_bias_samples, self.still_bias_max_std)
+        except ValueError as exc:
+            raise ValueError(f"gyro: {exc}") from None
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """R_cam_imu as a 3x3 array."""
+        return np.asarray(self.R_cam_imu, dtype=float).reshape(3, 3)
+
+    @property
+    def saturation_limit(self) -> float | None:
+        """The saturation limit, None for none."""
+        return self.saturation if self.saturation > 0 else None
+
+    @classmethod
+    def from_dict(cls, values: dict) -> "GyroConfig":
+        """From plain values by field name (missing: defaults); ValueError for unknown names or bad values."""
+        unknown = set(values) - {f.name for f in fields(cls)}
+        if unknown:
+            raise ValueError(f"unknown gyro parameters: {', '.join(sorted(unknown))}")
+        return cls(**values)
+
+    def to_dict(self) -> dict:
+        """Plain values by field name (sequences as lists); round-trips through :meth:`from_dict`."""
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}

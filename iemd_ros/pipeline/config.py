@@ -1,0 +1,87 @@
+"""The pipeline's parameters (:class:`PipelineConfig`): the tracker's and the gyro's groups and its own."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, fields
+
+from iemd_ros.common.params import coerce, param
+from iemd_ros.gyro import GyroConfig
+from iemd_ros.pipeline.parameter_file import NODE_NAME, read_parameter_file, read_yaml
+from iemd_ros.tracking import TrackerConfig
+
+__all__ = ["PipelineConfig", "GROUPS"]
+
+GROUPS = {"tracker": TrackerConfig, "gyro": GyroConfig}  # parameter groups: tracker.<name>, gyro.<name>
+
+
+@dataclass
+class PipelineConfig:
+    """Tracker + gyro settings and the pipeline's own (``PipelineConfig(tracker=TrackerConfig(...))``)."""
+
+    tracker: TrackerConfig = field(default_factory=TrackerConfig)
+    gyro: GyroConfig = field(default_factory=GyroConfig)
+    use_gyro: bool = param(True, "use the gyro prior K R^T K^-1", eq="section 5.2, Algorithm 3")
+    imu_wait_ms: float = param(15.0, "longest wait for IMU samples covering a frame before tracking it without the "
+                               "prior", unit="ms", range=(0.0, 1000.0))
+    clock_reset_ms: float = param(1000.0, "a stamp this much earlier than the previous one is a clock reset (smaller "
+                                  "steps back reject the frame)", unit="ms", range=(1.0, 1e7))
+    score_emd_scale: float = param(0.25, "detection score = exp(-EMD / score_emd_scale)", range=(1e-6, 100.0))
+
+    def __post_init__(self):
+        for name, kind in GROUPS.items():
+            if not isinstance(getattr(self, name), kind):
+                raise ValueError(f"{name} must be a {kind.__name__}")
+        coerce(self)
+
+    @classmethod
+    def from_dict(cls, values: dict) -> "PipelineConfig":
+        """From ``{"tracker": {...}, "gyro": {...}, "use_gyro": ..., ...}`` (missing keys: defaults)."""
+        v = dict(values)
+        unknown = set(v) - {f.name for f in fields(cls)}
+        if unknown:
+            raise ValueError(f"unknown pipeline parameters: {', '.join(sorted(unknown))}")
+        for name, kind in GROUPS.items():
+            group = v.get(name, {})
+            if not isinstance(group, dict):
+                raise ValueError(f"{name} must be a mapping of its parameters, got {group!r}")
+            v[name] = kind.from_dict(group)
+        try:
+            return cls(**v)
+        except TypeError as exc:
+            raise ValueError(f"invalid pipeline parameters: {exc}") from None
+
+    @classmethod
+    def from_parameters(cls, params: dict) -> "PipelineConfig":
+        """From parameters by their dotted names (``tracker.n_iter``, ``use_gyro``); names of no pipeline
+        parameter (the node's own: ``initial_box``, ...) are ignored."""
+        own = {f.name for f in fields(cls)} - set(GROUPS)
+        values: dict = {name: {} for name in GROUPS}
+        for key, value in params.items():
+            group, dot, name = str(key).partition(".")
+            if group in GROUPS:
+                if not dot:
+                    raise ValueError(f"{group} must be a group of parameters ({group}.<name>), got {value!r}")
+                values[group][name] = value
+            elif group in own:
+                if dot:
+                    raise ValueError(f"{group} is a single parameter, not a group: got {key!r}")
+                values[group] = value
+        return cls.from_dict(values)
+
+    @classmethod
+    def from_yaml(cls, path, node_name: str = NODE_NAME) -> "PipelineConfig":
+        """From a YAML file: a ROS parameter file (``config/tracker.yaml``) read as the node ``node_name`` reads it
+        (:func:`~iemd_ros.pipeline.parameter_file.read_parameter_file`), or a plain
+        ``{tracker: {...}, gyro: {...}, use_gyro: ...}`` mapping (:meth:`from_dict`).  ValueError naming the file
+        for a file that cannot be read or holds invalid values."""
+        params = read_parameter_file(path, node_name)
+        try:
+            return cls.from_dict(read_yaml(path)) if params is None else cls.from_parameters(params)
+        except ValueError as exc:
+            raise ValueError(f"config {path}: {exc}") from None
+
+    def to_dict(self) -> dict:
+        """Plain values (groups as mappings); round-trips through :meth:`from_dict`."""
+        d = {f.name: getattr(self, f.name) for f in fields(self)}
+        for name in GROUPS:
+            d[name] = getattr(self, name).to_dict()
+        return d

@@ -1,0 +1,118 @@
+"""The pipeline's diagnostics: OK/WARN/ERROR statuses computed from one snapshot of its counters (no state here)."""
+from __future__ import annotations
+
+import enum
+import math
+from dataclasses import dataclass
+
+__all__ = ["Level", "Part", "Status", "statuses", "LOST_ERROR_FRAMES", "IMU_ERROR_RUN", "rate_hz"]
+
+LOST_ERROR_FRAMES = 30  # lost this many frames in a row: ERROR
+IMU_ERROR_RUN = 10      # this many rejected IMU messages in a row: ERROR
+
+
+class Level(enum.IntEnum):
+    """Levels of diagnostic_msgs/DiagnosticStatus."""
+
+    OK = 0
+    WARN = 1
+    ERROR = 2
+
+
+class Part(enum.Enum):
+    """What a status is about (its value ends the status name: ``<node>: <part>``)."""
+
+    TRACKING = "tracking"
+    IMAGE = "image input"
+    IMU = "imu"
+    CAMERA = "camera_info"
+
+
+@dataclass(frozen=True)
+class Status:
+    """One diagnostic status about ``part``, with the values behind it (strings)."""
+
+    part: Part
+    level: Level
+    message: str
+    values: dict
+
+    def name(self, prefix: str) -> str:
+        return f"{prefix}: {self.part.value}"
+
+
+def statuses(d: dict) -> list[Status]:
+    """The tracking, image input, IMU and camera_info statuses of a :meth:`TrackingPipeline.diagnostics` snapshot."""
+    fmt = {k: (f"{v:.3f}" if isinstance(v, float) else str(v)) for k, v in d.items()}
+
+    def vals(*keys):
+        return {k: fmt[k] for k in keys}
+
+    return [
+        Status(Part.TRACKING, *_tracking(d), vals(
+            "state", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
+            "processing_ms_max", "processing_rate_hz", "inits", "resets", "frame_reason")),
+        Status(Part.IMAGE, *_image(d), vals(
+            "frames_received", "frames_processed", "frames_dropped", "frames_rejected", "images_malformed",
+            "input_rate_hz", "processing_rate_hz", "recent_dropped", "image_error", "drop_reason", "clock_resets")),
+        Status(Part.IMU, *_imu(d), vals(
+            "imu_received", "imu_rejected", "imu_out_of_order", "imu_saturated", "imu_stored", "imu_pending",
+            "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status")),
+        Status(Part.CAMERA, *_camera(d), vals("camera", "camera_infos", "camera_infos_rejected", "camera_error")),
+    ]
+
+
+def _tracking(d: dict) -> tuple[Level, str]:
+    if d["state"] == "uninitialized":
+        return Level.WARN, "no target: set the initial_box parameter or publish on ~/init"
+    if d["state"] == "lost":
+        level = Level.ERROR if d["lost_run"] >= LOST_ERROR_FRAMES else Level.WARN
+        return level, f"target lost for {d['lost_run']} frame(s): {d['frame_reason']}"
+    return Level.OK, f"tracking (EMD {d['emd']:.4f}, {d['iterations']} iterations)"
+
+
+def _image(d: dict) -> tuple[Level, str]:
+    if d["image_bad"]:
+        return Level.ERROR, f"latest image rejected: {d['image_error']}"
+    if d["frames_received"] == 0:
+        return Level.WARN, "no image received yet"
+    if d["recent_frames"] and d["recent_dropped"] > d["recent_frames"] // 2:
+        return Level.WARN, (f"processing falls behind: {d['recent_dropped']} of the last {d['recent_frames']} "
+                            "frames dropped (the newest is kept)")
+    if d["stamp_rejected"]:
+        return Level.WARN, f"latest rejected frame: {d['frame_reason']}"
+    return Level.OK, f"{d['input_rate_hz']:.1f} Hz in, {d['processing_rate_hz']:.1f} Hz processed"
+
+
+def _imu(d: dict) -> tuple[Level, str]:
+    if not d["use_gyro"]:
+        return Level.OK, "gyro prior disabled (use_gyro is false)"
+    if d["imu_bad_run"] >= IMU_ERROR_RUN:
+        return Level.ERROR, f"the last {d['imu_bad_run']} IMU samples were rejected: {d['imu_reason']}"
+    if d["imu_received"] == 0:
+        return Level.WARN, "no IMU message received: tracking without the gyro prior"
+    if d["imu_bad_run"]:
+        return Level.WARN, d["imu_reason"]
+    if d["recent_processed"] and d["last_gyro_used"] is False:
+        return Level.WARN, f"latest frame tracked without the gyro prior: {d['gyro_reason']}"
+    return Level.OK, f"gyro prior used on {d['recent_gyro_used']} of the last {d['recent_processed']} frames"
+
+
+def _camera(d: dict) -> tuple[Level, str]:
+    if not d["has_camera"]:
+        if d["camera_error"]:
+            return Level.ERROR, f"camera_info rejected: {d['camera_error']}"
+        if d["use_gyro"]:
+            return Level.WARN, "no camera_info received: the gyro prior needs K"
+        return Level.OK, "no camera_info (not needed: gyro disabled)"
+    if d["camera_error"]:
+        return Level.WARN, f"latest camera_info rejected ({d['camera_error']}); keeping the previous one"
+    return Level.OK, "camera model received"
+
+
+def rate_hz(stamps) -> float:
+    """Frames per second of message stamps (ns) over their span; nan with fewer than two."""
+    if len(stamps) < 2:
+        return math.nan
+    span = (max(stamps) - min(stamps)) * 1e-9
+    return (len(stamps) - 1) / span if span > 0 else math.nan

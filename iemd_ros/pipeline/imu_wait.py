@@ -1,0 +1,37 @@
+"""How long a frame waits for the gyro to cover it: one policy for the node (wall clock) and the replay (bag time)."""
+from __future__ import annotations
+
+__all__ = ["ImuWait"]
+
+
+class ImuWait:
+    """A frame goes to the tracker once the gyro covers it, or once it has waited ``imu_wait_ms``.
+
+    The clock is the caller's: the node passes monotonic wall-clock times, the replay the log times of the bag's
+    messages, so that a replay at any speed takes the decisions the node takes when the bag plays at 1x.
+
+    Parameters
+    ----------
+    pipeline : TrackingPipeline
+        Says whether the gyro covers a frame (:meth:`TrackingPipeline.gyro_ready`).
+    """
+
+    def __init__(self, pipeline):
+        self._pipeline = pipeline
+
+    @property
+    def wait_ns(self) -> int:
+        return int(round(self._pipeline.config.imu_wait_ms * 1e6))
+
+    def ready(self, stamp_ns: int) -> bool:
+        """Whether the frame stamped ``stamp_ns`` loses nothing by going now (the gyro covers it, or no prior
+        can be used)."""
+        return self._pipeline.gyro_ready(stamp_ns)
+
+    def waited_out(self, arrival_ns: int, now_ns: int) -> bool:
+        """Whether a frame that arrived at ``arrival_ns`` has waited its longest at ``now_ns``."""
+        return now_ns - arrival_ns > self.wait_ns
+
+    def remaining_s(self, arrival_ns: int, now_ns: int) -> float:
+        """Seconds the frame that arrived at ``arrival_ns`` may still wait at ``now_ns`` (<= 0: none)."""
+        return (arrival_ns + self.wait_ns - now_ns) * 1e-9

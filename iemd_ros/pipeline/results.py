@@ -1,0 +1,71 @@
+"""What the pipeline says about one frame: :class:`FrameResult`, its :class:`TrackState` and :class:`Rejection`."""
+from __future__ import annotations
+
+import enum
+from dataclasses import asdict, dataclass
+
+from iemd_ros.tracking import Cause
+
+__all__ = ["TrackState", "Rejection", "FrameResult", "INIT_REASON"]
+
+INIT_REASON = "target initialized on this frame"  # FrameResult.reason of the frame init() started on
+
+
+class TrackState(enum.Enum):
+    """The pipeline's tracking state (its value is the replay CSV's ``state``)."""
+
+    UNINITIALIZED = "uninitialized"  # no target: waiting for an initial box
+    TRACKING = "tracking"            # the window is on the target (also when held: tracked, models not updated)
+    LOST = "lost"                    # the tracker's window no longer looks like the target
+
+
+class Rejection(enum.Enum):
+    """Why a frame was not tracked (its value is the replay CSV's ``state`` of such a frame)."""
+
+    STAMP = "rejected"      # its stamp repeats or goes back from the previous frame's
+    MALFORMED = "malformed"  # the image message did not convert or decode
+
+
+@dataclass(frozen=True, kw_only=True)
+class FrameResult:
+    """Outcome of one frame.
+
+    ``box``/``angle``/``emd``/``iterations``/``held``/``cause`` come from the tracker
+    (:class:`~iemd_ros.tracking.TrackResult`; the best window searched, also when lost): ``angle`` (radians) is
+    the window's turn, which the gyro priors change (mostly the camera's roll), and ``box`` ``(x, y, w, h)`` the
+    axis-aligned bounding box of the turned window.  ``score`` = ``exp(-emd / score_emd_scale)`` while tracking,
+    else 0.  ``gyro_box``: the gyro's predicted window; ``predicted_box``: the tracker's starting window (after the
+    gyro prior).  ``reason`` says why the frame is lost, held, rejected or untracked.  ``processing_ms`` is
+    wall-clock time; everything else depends only on the messages.
+    """
+
+    stamp_ns: int
+    state: TrackState
+    box: tuple | None = None
+    emd: float = float("nan")
+    score: float = 0.0
+    iterations: int = 0
+    lost: bool = False
+    held: bool = False
+    cause: Cause | None = None
+    reason: str = ""
+    rejection: Rejection | None = None
+    gyro_used: bool = False
+    gyro_reason: str = ""
+    gyro_box: tuple | None = None
+    predicted_box: tuple | None = None
+    scale: float = 1.0
+    starts: int = 0
+    codings: int = 0
+    solver_warnings: int = 0
+    processing_ms: float = 0.0
+    angle: float = 0.0
+    is_init: bool = False  # the result of the frame TrackingPipeline.init started on
+
+    @property
+    def tracking(self) -> bool:
+        """Whether the frame was tracked and the target is reported (a detection is published)."""
+        return self.state is TrackState.TRACKING and self.rejection is None
+
+    def as_dict(self) -> dict:
+        return asdict(self)

@@ -1,0 +1,36 @@
+"""Probes into a running tracker for the benchmarks: the EMD of any window against its target model, and
+Algorithm 1 alone from a window.  Neither changes the tracker's state."""
+from __future__ import annotations
+
+import numpy as np
+
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.tracking.appearance import ImagePyramid, to_gray
+from iemd_ros.tracking.candidate import CandidateModel, SearchContext
+from iemd_ros.tracking.tracker import IemdTracker, TrackResult, _box, _check_box, _check_frame, _not_optimal
+
+__all__ = ["search_context", "descend"]
+
+
+def search_context(tracker: IemdTracker, pyramid: ImagePyramid, angle: float = 0.0) -> SearchContext:
+    """The context the tracker's search samples windows in on ``pyramid``'s frame: its current target model and
+    dictionary.  ``CandidateModel(search_context(tracker, pyramid), centre, size).emd()`` scores any window."""
+    if tracker._center is None:
+        raise RuntimeError("search_context() needs an initialized tracker")
+    return tracker._context(pyramid, angle)
+
+
+def descend(tracker: IemdTracker, frame: np.ndarray, box) -> TrackResult:
+    """Algorithm 1 alone on ``frame`` from the axis-aligned window ``box`` = (x, y, w, h), at that size, against
+    the tracker's current target model: no other starts, no filter, no scale search; the tracker is unchanged."""
+    if tracker._center is None:
+        raise RuntimeError("descend() needs an initialized tracker")
+    _check_frame(frame)
+    x, y, w, h = _check_box(box, frame.shape)
+    size = np.array([w, h], dtype=np.float64)
+    start = CandidateModel(search_context(tracker, ImagePyramid(to_gray(frame))), box_centre((x, y, w, h)), size)
+    end = tracker._descend(start)
+    cause, reason = tracker._lost_reason(end.emd, end.center, size, 0.0, frame.shape)
+    return TrackResult(box=_box(end.center, size), emd=end.emd, iterations=end.iterations, lost=cause is not None,
+                       codings=1 + end.codings, solver_warnings=_not_optimal(start.emd()[1]) + end.warnings,
+                       reason=reason, cause=cause)

@@ -1,0 +1,1 @@
+"""Named tracker configurations, one module per variant, each with ``parameters() -> TrackerConfig``."""

@@ -1,0 +1,6 @@
+"""The shipped tracker: iEMD with its discriminative extensions (the defaults of TrackerConfig)."""
+from iemd_ros.tracking.config import TrackerConfig
+
+
+def parameters() -> TrackerConfig:
+    return TrackerConfig()
