@@ -24,8 +24,9 @@ import numpy as np
 from iemd_ros import IemdTracker
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.analysis import descend
 
-GRADIENTS = ("paper", "envelope", "appearance")
+GRADIENTS = ("paper", "appearance")
 CASES = ("next frame", "known shift")
 
 
@@ -60,7 +61,7 @@ def main():
                     start = centre_box(truth + offset, size)
                     for gradient in GRADIENTS:
                         tracker.config.gradient = gradient  # only the descent reads it
-                        result = tracker.descend(frame, start)
+                        result = descend(tracker, frame, start)
                         errors[case, gradient].append(np.linalg.norm(box_centre(result.box) - truth))
                         iterations[case, gradient].append(result.iterations)
     for case in CASES:

@@ -31,6 +31,7 @@ from iemd_ros.tracking.candidate import CandidateModel
 from iemd_ros.evaluation.metrics import iou
 from iemd_ros.evaluation.ope import sequence_names
 from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.analysis import descend, search_context
 
 OFFSETS = np.linspace(-0.6, 0.6, 13)
 CAPTURE_STARTS = (0.05, 0.1, 0.2, 0.3, 0.4)
@@ -64,7 +65,7 @@ def measure(job):
         truth = np.asarray(seq.gt_boxes[k], dtype=float)
         frame = read_frame(seq.frame_paths[k])
         pyramid = ImagePyramid(to_gray(frame))
-        context, size = tracker.search_context(pyramid), truth[2:]
+        context, size = search_context(tracker, pyramid), truth[2:]
 
         def emd(centre):
             return CandidateModel(context, centre, size).emd()[0]
@@ -74,7 +75,7 @@ def measure(job):
             return -np.corrcoef(reference, window)[0, 1]
 
         start = np.asarray(seq.gt_boxes[k - jump], dtype=float)
-        stepped = tracker.descend(frame, start).box
+        stepped = descend(tracker, frame, start).box
         rows.append((_grid_argmin_iou(emd, truth), _grid_argmin_iou(ncc, truth),
                      iou(np.array([stepped]), truth[None])[0], iou(start[None], truth[None])[0]))
     return name, 100.0 * np.mean(rows, axis=0)
@@ -93,7 +94,7 @@ def capture(name):
             direction = np.array([np.cos(angle), np.sin(angle)])
             for i, distance in enumerate(CAPTURE_STARTS):
                 start = centre_box(centre + distance * size * direction, size)
-                end = box_centre(tracker.descend(frame, start).box)
+                end = box_centre(descend(tracker, frame, start).box)
                 converged[i] += np.linalg.norm((end - centre) / size) < 0.05
             searches += 1
     return name, 100.0 * converged / searches

@@ -16,8 +16,6 @@ import sys
 from pathlib import Path
 
 import cv2
-import numpy as np
-
 from iemd_ros import IemdTracker, TrackerConfig
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"

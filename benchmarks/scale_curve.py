@@ -33,6 +33,7 @@ from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking.candidate import CandidateModel
 from iemd_ros.evaluation.ope import sequence_names
 from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.analysis import search_context
 
 SCALES = np.exp(np.linspace(np.log(0.8), np.log(1.25), 23))  # 2.0 % apart; SCALES[11] = 1
 SHOWN = (0, 4, 8, 10, 12, 14, 18, 22)  # 0.80, 0.87, 0.94, 0.98, 1.02, 1.06, 1.15, 1.25
@@ -50,7 +51,7 @@ def curve(job):
     for k in range(stride, len(seq), stride):
         truth = np.asarray(seq.gt_boxes[k], dtype=float)
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
-        context, centre = tracker.search_context(pyramid), box_centre(truth)
+        context, centre = search_context(tracker, pyramid), box_centre(truth)
         emd = [CandidateModel(context, centre, truth[2:] * s).emd()[0] for s in SCALES]
         ncc = [-np.corrcoef(reference, pyramid.sample(centre, truth[2:] * s, template_size).ravel())[0, 1]
                for s in SCALES]
@@ -63,7 +64,7 @@ def oracle_translation(job):
     ground-truth centre before each update (the public API: no private state is set)."""
     name, config = job
     seq = load_sequence(name, default_root())
-    tracker = IemdTracker(TrackerConfig.from_dict(dict(n_iter=0, flow_start=False, coarse_to_fine=False, **config)))
+    tracker = IemdTracker(TrackerConfig.from_dict(dict(n_iter=0, flow_start=False, **config)))
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     errors = []
     centre = box_centre(seq.gt_boxes[0])  # the tracker's window centre (it moves only on frames not lost)

@@ -2,7 +2,7 @@
 """Compare IemdTracker configurations on OTB sequences: average overlap and EMD discrimination.
 
     python benchmarks/tune_tracker.py --sequences Car4,Bolt2,Woman \
-        --config "{}" --config "{'normalization': 'l2'}" [--frames N] [--discrimination]
+        --config "{}" --config "{'lam': 0.2}" [--frames N] [--discrimination]
 
 Average overlap is the paper's metric over the whole sequence (or its first N
 frames).  ``--discrimination`` also reports, on a few frames per sequence, the
@@ -25,6 +25,7 @@ from iemd_ros.evaluation.ope import evaluate_sequence, make_tracker
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking.candidate import CandidateModel
 from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.analysis import search_context
 
 
 def overlap(job):
@@ -45,7 +46,7 @@ def discrimination(job, radius=40, grid=4):
     scores = []
     for k in picks:
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
-        context, center, size = tracker.search_context(pyramid), box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
+        context, center, size = search_context(tracker, pyramid), box_centre(seq.gt_boxes[k]), seq.gt_boxes[k][2:]
         at_gt = CandidateModel(context, center, size).emd()[0]
         others = [CandidateModel(context, center + (dx, dy), size).emd()[0]
                   for dy in range(-radius, radius + 1, grid) for dx in range(-radius, radius + 1, grid)

@@ -40,6 +40,7 @@ from iemd_ros.tracking.emd import ground_distance, solve_emd
 from iemd_ros.tracking.histogram import candidate_weights
 from iemd_ros.evaluation.ope import sequence_names
 from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.tracking.analysis import search_context
 from model_ceiling import grid_argmin  # benchmarks/ is the script's directory
 
 OFFSETS = np.linspace(-0.4, 0.4, 9)
@@ -57,7 +58,7 @@ class VoteHistogram:
         self.bin_pos = tracker.layout.positions()
         atoms = self.coder.dictionary.T
         self.cost = ground_distance(atoms, self.bin_pos, atoms, self.bin_pos, cfg.alpha)
-        self.dense = PatchLayout(cfg.template_size, cfg.patch_size, DENSE_STEP, cfg.normalization)
+        self.dense = PatchLayout(cfg.template_size, cfg.patch_size, DENSE_STEP)
         self.w_t = self.histogram(tracker.dictionary.templates[0])
 
     def votes(self, template):
@@ -97,7 +98,7 @@ def measure(job):
         pyramid = ImagePyramid(to_gray(read_frame(seq.frame_paths[k])))
         center, size = box_centre(seq.gt_boxes[k]), np.asarray(seq.gt_boxes[0][2:], dtype=float)  # frame-1 size
         accuracy = votes.vote_accuracy(pyramid.sample(center, size, tsize))
-        context = tracker.search_context(pyramid)
+        context = search_context(tracker, pyramid)
         patch_bins = np.hypot(*grid_argmin(lambda c: CandidateModel(context, c, size).emd()[0], center, size, OFFSETS))
         vote_bins = np.hypot(*grid_argmin(lambda c: votes.emd(pyramid.sample(c, size, tsize)), center, size, OFFSETS))
         rows.append((accuracy, patch_bins, vote_bins))

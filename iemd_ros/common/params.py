@@ -20,6 +20,8 @@ import math
 import typing
 from dataclasses import MISSING, dataclass, field
 
+import numpy as np
+
 __all__ = ["Spec", "param", "specs", "coerce", "Choice", "number_text"]
 
 
@@ -115,7 +117,7 @@ def _scalar(name: str, value, kind, spec: Spec):
             choices = ", ".join(str(c.value) for c in kind)
             raise ValueError(f"{name} must be one of {choices}, got {value!r}") from None
     if kind is bool:
-        if not isinstance(value, bool) and type(value).__name__ != "bool_":
+        if not isinstance(value, (bool, np.bool_)):
             raise ValueError(f"{name} must be true or false, got {value!r}")
         return bool(value)
     if kind is str:

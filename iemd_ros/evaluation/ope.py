@@ -1,4 +1,4 @@
-"""``iemd-eval``: one-pass evaluation (OPE) of trackers on OTB sequences, as the paper and the field do.
+"""One-pass evaluation (OPE) of trackers on OTB-layout sequences, as the paper and the field do (``iemd-eval``).
 
 Protocol (Wu, Lim & Yang 2013; paper, Section "Experiments"): each tracker is initialised with the GT box
 of the first frame and then updated on every later frame without re-initialisation.  The first frame
@@ -15,14 +15,8 @@ CSRT/KCF return ``(False, (0, 0, 0, 0))`` when their confidence test fails) the 
 That is OpenCV's internal state: on a failed test both trackers return before moving or updating their
 model, and resume from that position (test_evaluation checks it for KCF).  The rule is the same for every tracker
 (iEMD always returns a box; ``result.lost`` is only counted).  The per-frame ``ok`` flags and the count
-``failures`` are in ``results.json``, so the failed frames can be rescored as misses (measured with
-OpenCV 5.0.0: scoring the empty box instead drops KCF's mean average overlap over the 12 OTB targets
-from 20.4 % to 9.2 %, CSRT's from 51.3 % to 51.1 %).
-
-Usage::
-
-    iemd-eval [ROOT_OR_SEQ ...] [--trackers iemd,csrt,kcf] [--sequences Car4,Bolt2] [--max-frames N] [--out DIR]
-              [--config config/tracker.yaml]
+``failures`` are in ``results.json``, so the failed frames can be rescored as misses
+(docs/decisions.md#evaluation-failures).
 """
 from __future__ import annotations
 

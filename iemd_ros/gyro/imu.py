@@ -49,7 +49,7 @@ class SampleStatus(IntEnum):
 
 
 # The statuses as plain ints for ImuBuffer.add and GyroPredictor.add_imu: numpy comparing an array with an
-# IntEnum member probes the enum class for array attributes, which doubled the cost of adding one IMU sample.
+# IntEnum member probes the enum class for array attributes on every comparison.
 ACCEPTED_STATUS, _NOT_FINITE, _SATURATED = (int(s) for s in SampleStatus)
 _NO_STAMP = np.iinfo(np.int64).min      # "no stamp yet" for the compiled screening: nothing is earlier
 
@@ -288,8 +288,7 @@ def _window_rotation(rel, ws, t_end, coning):
     ``rel`` (s, strictly increasing) brackets the window: rel[0] <= 0 < t_end <= rel[-1], so it
     holds at least 2 samples (``integrate`` answers an empty window before calling).  The knots are
     0, the samples strictly inside and t_end, with the rate interpolated linearly at both ends (as
-    ``np.interp``).  One compiled pass: the numpy version spent ~0.3 ms per frame in array overhead
-    for a handful of samples.
+    ``np.interp``).  One compiled pass: for a handful of samples numpy's array overhead dominates.
     """
     knots = np.empty(rel.size + 2)
     rates = np.empty((rel.size + 2, 3))

@@ -9,8 +9,7 @@ frame ``k-1`` is seen in frame ``k`` at ``x' ~ K R^T K^-1 x``.  This is the pape
 frame to the box of frame ``k-1``: eq. 24's accumulation ``H^{k+1} = H^k H_gyro^-1`` applied to
 ``p(k)`` (already the tracked position in frame k) would count earlier rotations twice, so it is not
 used.  The direction is checked on the synthetic generator (test) and on the real recordings
-(``benchmarks/gyro_prewarp.py``: ``K R^T K^-1`` roughly halves the grey-level error, ``K R K^-1``
-makes it worse).
+(``benchmarks/gyro_prewarp.py``).
 
 Lens distortion
 ---------------
@@ -255,11 +254,8 @@ class GyroPredictor:
 
 
 def warm_up() -> None:
-    """JIT-compile the gyro path's numba kernels now (or load them from numba's on-disk cache):
-    the IMU screening, the window integration and the lens model.  In a fresh environment the first
-    IMU message and gyro prediction otherwise stall for seconds (4.5 s measured on a cold cache);
-    :class:`iemd_ros.pipeline.pipeline.TrackingPipeline` (node and replay) calls this, with
-    :func:`iemd_ros.tracking.tracker.compile_jit`, once per process at start-up."""
+    """Compile the gyro path's numba kernels now (or load them from numba's on-disk cache): the IMU screening,
+    the window integration and the lens model, so that the first IMU message and prediction do not stall."""
     predictor = GyroPredictor(CameraModel(np.diag([100.0, 100.0, 1.0]), [0.1, 0.0, 0.0, 0.0, 0.0], 64, 48))
     predictor.add_imu(np.array([0, 10_000_000, 20_000_000]), np.full((3, 3), 0.1))
     predictor.predict(2_000_000, 12_000_000, (16.0, 16.0, 16.0, 16.0))

@@ -4,8 +4,7 @@ Algorithm 1 builds a new candidate model each time the window moves: the
 window at ``center`` is resampled to the template size and cut into the same
 patch grid as the target, so candidate patch v and target patch u are aligned
 whenever the window sits on the target (a fixed patch lattice that is not
-re-sampled is misaligned between its grid points: on a pure 2.4 px
-translation its EMD minimum sat 1.2 px short of the truth).
+re-sampled is misaligned between its grid points).
 
 Everything but the window is fixed for one search on one frame: it is held
 in a :class:`SearchContext`, and a candidate model is ``CandidateModel(context,

@@ -1,39 +1,21 @@
 """Colour evidence of the window's position: foreground and background colour histograms (Staple).
 
-Why the tracker needs it: the iEMD patches and both correlation filters see grey levels only, and a
-target often differs from its surroundings more in colour than in grey-level texture (over 12 OTB
-sequences x 5 starts the model lifted Bolt2 from 27.7 to 39.3 % and DragonBaby from 18.1 to 40.2 %).  It
-does not see through an occlusion: while the post hides Jogging-1's runner the window on the post scores a
-colour mean of 0.66-0.70, as high as on her (her tall box holds much background).  Staple (Bertinetto et
-al., "Staple: Complementary Learners for Real-Time Tracking", CVPR 2016, eq. 20-22) scores a window by the
-share of its pixels whose colour is more frequent on the target than around it: per colour bin b, with
-rho_O(b) and rho_B(b) the fractions of the target's and of the surrounding pixels in b, a pixel of bin b
-scores beta(b) = rho_O / (rho_O + rho_B) (0 where neither has it; a table kept with the histograms) and a
-window the mean of beta over its pixels, computed for every window position at once from an integral
-image.
+The iEMD patches and the correlation filters see grey levels only, and a target often differs from its
+surroundings more in colour than in texture.  Staple (Bertinetto et al., "Staple: Complementary Learners for
+Real-Time Tracking", CVPR 2016, eqs. 20-22) scores a window by the share of its pixels whose colour is more frequent
+on the target than around it: per colour bin b, with rho_O(b) and rho_B(b) the fractions of the target's and of the
+surrounding pixels in b, a pixel of bin b scores beta(b) = rho_O / (rho_O + rho_B) (0 where neither has it; a table
+kept with the histograms) and a window the mean of beta over its pixels, for every window position at once from an
+integral image.
 
-Here the search region, the window's size plus ``padding`` times sqrt(w h) on every side (and the
-window itself once more, so every window centred up to that far is inside it), is resampled in the
-window's axes to at most ``model_area`` pixels (nearest neighbour: colours are not blended), so the
-cost does not grow with the target and a window turned by the gyro prior is handled like any other.
-The histograms count RGB in ``bins`` levels per channel over the window (the target) and over the
-window grown by half its mean side less the window (the surroundings, Staple's areas), as running
-averages at ``learning_rate``.  Parts outside the image are padded by replicating the border, as
-Staple does.  The tracker (``TrackerConfig.colour_weight``) takes the position of highest mean as one
-more start and the mean at each window as evidence in its score; it uses the model only on colour
-frames (a grey frame's histogram would repeat the grey levels the EMD already sees).
-
-Choices, measured over the 12 OTB sequences x 5 starts with colour_weight 0.75 (mean average overlap
-42.8 %, 38.6 % without the model; 4 more starts along the axes 41.7 %, 37.6 % without): padding 1 (0.5 / 2:
-40.5 / 41.7 %; at 2 Jogging-1/2 reach 51.4 / 41.6 % but Bolt2 and Woman fall to 13.4 / 18.3 %); Staple's
-learning rate 0.04 (0.02 / 0.01: 43.2 / 42.9 % over the 5 starts but 39.5 / 41.2 % over the axis starts;
-0.08: 41.0 %); 32 levels per channel (16: 39.4 %); the whole window as the target's area (shrunk by a fifth
-of the mean side, as Staple does: 38.9 %; its pixels weighted by the Epanechnikov kernel of the
-paper's histograms: 41.1 %); the colour peak as the start, not Staple's merged one (the peak of
-translation_weight x the filter's response + colour_weight x the colour mean over the colour map's
-windows, in place of the colour peak or besides it: 40.3 / 40.0 %).  Estimate and update take about 0.2
-and 0.4 ms (a 64-px target on 640x480 frames; the region is resampled, so the cost hardly grows with the
-target).
+The search region, the window's size plus ``padding`` times sqrt(w h) on every side (and the window itself once
+more, so every window centred up to that far is inside it), is resampled in the window's axes to at most
+``model_area`` pixels (nearest neighbour: colours are not blended), so the cost does not grow with the target and a
+window turned by the gyro prior is handled like any other.  The histograms count RGB in ``bins`` levels per channel
+over the window (the target) and over the window grown by half its mean side less the window (the surroundings,
+Staple's areas), as running averages at ``learning_rate``; parts outside the image replicate its border.  The
+tracker takes the position of highest mean as one more start and the mean at each window as evidence in its score,
+on colour frames only (docs/decisions.md#colour-model).
 """
 from __future__ import annotations
 

@@ -106,8 +106,8 @@ def _orientation_histograms(windows):
                 if gy < 0.0 or (gy == 0.0 and gx < 0.0):  # unsigned: fold onto [0, pi)
                     gx, gy = -gx, -gy
                 # The bin: the last boundary at or below the orientation, i.e. the number of boundaries 1..8 it is
-                # at or above (on [0, pi) "at or above boundary b" holds for b up to the bin and fails after it).
-                # Counted without branches: 30 % faster than stopping at the first failure, same bins.
+                # at or above (on [0, pi) "at or above boundary b" holds for b up to the bin and fails after it),
+                # counted without branches.
                 b = 0
                 for boundary in range(1, N_ORIENTATIONS):
                     b += gy * _BOUNDARY_COS[boundary] >= gx * _BOUNDARY_SIN[boundary]

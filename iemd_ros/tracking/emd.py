@@ -1,29 +1,18 @@
 """Earth Mover's Distance between target and candidate histograms (section 3).
 
-The transportation problem of eqs. (4)-(8) is solved with POT's network
-simplex (``ot.emd``'s solver ``emd_c``), which returns the optimal flow and the dual potentials
-``u`` (target bins) and ``v`` (candidate bins) of eq. (dual).  By strong
-duality ``D* = <u, w_T> + <v, w_C>``, so ``v`` is the vector ``M`` of eq. (9)
-that expresses the EMD as a linear function of the candidate weights on the
-optimal basis, and the paper's gradient eq. (10) is ``sum_v v_v dw_C,v/dy``.
-Non-optimal solver exits are reported in :class:`EmdSolution`, never hidden.
-
-Both histograms are normalized and all their mass is moved, as in the paper.  A partial
-matching that moves only a share m of it (one dummy bin on each side, free to reach, so that
-an occluded part of the window need not be matched; the duals and gradients stay valid) was
-measured over the 12 OTB sequences at m = 0.9 / 0.8 / 0.7 / 0.5: 28.5 / 16.9 / 23.8 / 20.9 %
-mean average overlap against 31.9 % (Woman, occluded by a car, stays at 12-15 %).  Pele and Werman's
-EMD-hat (candidate mass left unnormalized relative to the target's, so a window whose patches code
-weakly is short of mass, the mismatch paid at a cost P per unit) was measured at P = 0.3 / 1 / 3:
-8.7 / 13.0 (Car4 and Woman only) / 26.1 %, and with surplus mass ignored at P = 1 / 3: 19.8 / 28.0 %.
+The transportation problem of eqs. (4)-(8) is solved with POT's network simplex (``ot.emd``'s solver ``emd_c``),
+which returns the optimal flow and the dual potentials ``u`` (target bins) and ``v`` (candidate bins) of eq. (dual).
+By strong duality ``D* = <u, w_T> + <v, w_C>``, so ``v`` is the vector ``M`` of eq. (9) that expresses the EMD as a
+linear function of the candidate weights on the optimal basis, and the paper's gradient eq. (10) is
+``sum_v v_v dw_C,v/dy``.  Non-optimal solver exits are reported in :class:`EmdSolution`, never hidden.  Both
+histograms are normalized and all their mass is moved, as in the paper (docs/decisions.md#emd-solver).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
-# POT's network simplex without the backend dispatch of ``ot.emd`` around it
-# (measured: 0.17 vs 0.27 ms per 49x49 problem, ~20 solves per frame).
+# POT's network simplex without the backend dispatch of ``ot.emd`` around it (docs/decisions.md#emd-solver)
 from ot.lp.emd_wrap import emd_c
 
 _RESULT_MESSAGES = {0: "infeasible", 1: "optimal", 2: "unbounded",

@@ -1,7 +1,7 @@
 """Median optical flow of the target window: one more starting point for Algorithm 1 (section 6.1).
 
 The paper meets abrupt motion with extra starting points around the prediction.  The iEMD
-descent only converges from about 0.05 window sizes off the target (``IemdTracker._search``), so a
+descent only converges from a few pixels off the target (docs/decisions.md#capture-range), so a
 start placed where the target's own pixels moved is worth more than a blind ring of them: corners
 inside the window (Shi-Tomasi) are followed into the new frame by pyramidal Lucas-Kanade, points
 whose forward-backward error exceeds ``max_error`` px are dropped (Kalal et al.'s Median Flow),
@@ -18,10 +18,8 @@ from iemd_ros.common.boxes import map_points
 
 N_POINTS = 60  # corners followed per frame, at most
 MIN_POINTS = 4  # fewer surviving points give no start
-# Lucas-Kanade window and pyramid depth: motions up to about 5 * 2**3 = 40 px beyond the prediction.
-# 11x11 was measured at 28.7 % (12 sequences x 5 starts, particles on, the flow start sent through the
-# coarse stage as well; see TrackerConfig.flow_start) against 28.0 % for 15x15, at 0.6-0.8 ms against
-# 0.8-1.3 ms per frame.
+# Lucas-Kanade window and pyramid depth: motions up to about 5 * 2**3 = 40 px beyond the prediction
+# (docs/decisions.md#flow-start).
 _LK = dict(winSize=(11, 11), maxLevel=3)
 
 

@@ -1,38 +1,13 @@
 """Kernel-weighted histograms of sparse codes: eqs. (sparse target model) and (sparse candidate model).
 
-Bin r carries the pooled code weight ``p_r`` (or ``q_r``) of patch r and the
-Epanechnikov profile ``k(x) = max(0, 1 - x)`` of its squared normalized distance
-to the window centre, ``x = ||(c_r - y) / h||^2``.
+Bin r carries the pooled code weight ``p_r`` (or ``q_r``) of patch r and the Epanechnikov profile
+``k(x) = max(0, 1 - x)`` of its squared normalized distance to the window centre, ``x = ||(c_r - y) / h||^2``.
 
-Reading of section 4 (its index u of ``p_ru`` is ambiguous): every patch is a
-bin, with its own appearance and position in the ground distance.  The other
-reading, K bins at the dictionary's patch positions, each densely sampled patch
-voting ``||a_bar_r||_inf`` into the bin of its largest pooled code, needs that
-largest code to name where the patch sits in the target.  Measured
-(benchmarks/vote_histogram.py, 12 OTB sequences, frame-1 dictionary, frames
-10-90): on frame 1 itself 60.9 % of the step-2 patches vote within one patch
-step of their place, on later frames 27.6 %; the lowest EMD on a +-0.4 window
-grid lies 0.230 window sizes from the truth against 0.197 for per-patch bins.
-A prototype tracker on the votes (kernel moving over fixed dense patches, not
-kept) scored 2.7-14.1 % average overlap on Car4/Bolt2/Woman.
-
-Bandwidth choice (the paper only says "h is template size"): positions are in
-normalized window units (the window is [-1, 1]^2).  The tracker's default is
-h = 1, the ellipse inscribed in the window (the corner patches of the
-8x8/step-4 layout get no weight: 45 of 49 bins); h = sqrt(2) would reach zero
-at the window's circumscribed circle and weight every patch.  Measured
-(benchmarks/tune_tracker.py and iemd-eval, 12 OTB sequences, mean average
-overlap, L = 1): h = 1.0: 31.9 %; 1.2: 31.2 %; 1.414: 34.7 %; sqrt(2): 28.2 %;
-1.7: 27.1 %.  1.414 and sqrt(2) differ by 6.5 points through single sequences
-(Bolt2 50.6 vs 8.2 %): no value is reliably better, and h = 1 solves smaller
-EMDs.  The kernel is not scaled with the window: the scale search resamples
-the window instead (IemdTracker._search_scale says why).
-
-The kernel is the paper's, not learned from the first frame's background.  Scaling each bin of
-target and candidate by how unlike the background ring around the frame-1 target its patch is
-(mean shift's background-weighted histogram, as a per-position mask on the kernel) was measured
-at 19.1 % (background patches voting for their nearest target patch) and 20.9 % (distance to the
-nearest background patch) against 31.9 %, 12 OTB sequences.
+Section 4's index u of ``p_ru`` is read as: every patch is a bin, with its own appearance and position in the
+ground distance (docs/decisions.md#histogram-bins).  Positions are in normalized window units (the window is
+[-1, 1]^2); the paper only says "h is template size", and h = 1 is the ellipse inscribed in the window, where the
+corner patches of the 8x8/step-4 layout get no weight (docs/decisions.md#kernel-bandwidth).  The kernel is not
+scaled with the window: the scale search resamples the window instead.
 """
 from __future__ import annotations
 

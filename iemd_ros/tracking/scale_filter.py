@@ -1,32 +1,15 @@
 """Discriminative scale estimation: a one-dimensional correlation filter over scales (DSST).
 
-Why the tracker needs it: the EMD of the iEMD histograms hardly changes with the window's scale.
-Its patch positions are in normalized window units and its patches are normalized, so a window
-13 % too large or too small scores almost the same EMD.  Measured at the ground-truth centre with
-the frame-1 target model, every 5th frame, median EMD(s) / EMD(1) for s = 0.87 / 1.15
-(``benchmarks/scale_curve.py``): Car4 1.15 / 1.11, but Woman 1.02 / 1.01, David 1.01 / 1.05, Bolt2
-1.00 / 1.01; the paper's +-2 % variants then choose a scale by noise.  Keeping the window at the
-ground-truth size (an oracle scale) lifted the tracker's Car4 / Woman average overlap from
-36.7 / 51.6 % to 90.7 / 75.8 %.
-
-The filter is Danelljan et al.'s scale filter ("Accurate Scale Estimation for Robust Visual
-Tracking", BMVC 2014): the window at ``n_scales`` scales ``scale_step**k`` around the current
-size is resampled to one small model size and described by gradient-orientation histograms; the
-features of the scales, tapered by a Hann window over the scale axis, form a d x S sample whose
-desired response is a Gaussian peaked at the current scale.  The filter (eq. 5 of DSST, solved in
-the Fourier domain along the scale axis) and its running average (learning rate eta) give, on the
-next frame, the scale whose response peaks.  It learns what the target looks like at its own scale
-against itself a little larger and smaller, which is what the generative EMD cannot see.
-
-Choices, measured over the 12 OTB sequences x 5 starts (mean average overlap; the EMD variants 32.5 %):
-DSST's 33 scales 1.02 apart, learning rate 0.025 (0.01 / 0.05 scored 31.8 / 33.1 % where 0.025 scored
-35.8 %, flow_max_error 2 px), regularization 0.01 and 512-pixel model; all scales
-sampled from one pyramid level, so their smoothing differs by the scale only (34.4 %; each from its own
-anti-aliasing level 35.7 %, at 6x the sampling cost); learning from the estimate's own sample (DSST
-samples the new window again: 35.0 %, 1.2 ms more per frame).  In an earlier setting of the flow
-start, 17 scales scored 33.2 % where 33 sampled twice scored 35.6 %.  Detecting with a 30 % share of the
-first frame's filter mixed in (against drift) scored 34.2 %, and 15.5 % scale error in the loop of
-``benchmarks/scale_curve.py`` against 13.8 %.
+The EMD of the iEMD histograms hardly changes with the window's scale: its patch positions are in normalized window
+units and its patches are normalized, so a window somewhat too large or too small scores almost the same EMD
+(docs/decisions.md#scale-estimator).  This is Danelljan et al.'s scale filter ("Accurate Scale Estimation for Robust
+Visual Tracking", BMVC 2014): the window at ``n_scales`` scales ``scale_step**k`` around the current size is
+resampled to one small model size and described by gradient-orientation histograms; the features of the scales,
+tapered by a Hann window over the scale axis, form a d x S sample whose desired response is a Gaussian peaked at the
+current scale.  The filter (eq. 5 of DSST, solved in the Fourier domain along the scale axis) and its running
+average (learning rate eta) give, on the next frame, the scale whose response peaks.  All scales are sampled from
+one pyramid level, so their smoothing differs by the scale only, and the filter learns from the estimate's own
+sample.
 """
 from __future__ import annotations
 

@@ -1,33 +1,12 @@
 """Non-negative sparse coding and max-alignment pooling (paper section 4).
 
-Every local patch ``epsilon`` is coded against the dictionary ``Phi`` by the
-non-negative lasso of eq. (lagrange)::
+Every local patch ``epsilon`` is coded against the dictionary ``Phi`` by the non-negative lasso of eq. (lagrange)::
 
     min_a ||epsilon - Phi a||_2^2 + lambda ||a||_1   s.t.  a >= 0
 
-Solver choice (measured on 49 real Car4 patches x 245 atoms, this machine):
-exact active set on the Gram matrix (numba) 1-9 ms with KKT residual ~1e-15;
-scipy ``nnls`` on the equivalent augmented system 23 ms; numpy FISTA 43 ms at
-300 iterations and still a KKT residual of 9e-3 (the dictionary of raw patches
-is highly coherent, so first-order methods crawl); scikit-learn's
-``sparse_encode(lasso_cd, positive=True)`` did not converge in 88 ms.
-SPAMS does not build here.  The active set (Lawson-Hanson on the quadratic
-program ``a'Ga - 2(b - lambda/2)'a``) terminates with the exact solution, so
-the KKT conditions hold to rounding, and it is fastest for sparse codes.  With
-the residual updated row-wise in place it coded 49 patches in 0.4 ms against
-147 atoms (L = 3) and 0.1 ms against 49 atoms (L = 1, the default) on a lightly
-loaded day.  Extending the
-Cholesky factor of the active block by a row per entering atom, instead of
-factoring the block anew at every solve, made it 1.9x faster (0.27 -> 0.14 ms per
-49 patches x 49 atoms on a loaded day, 60 real windows of Woman/Bolt2/Car4, same codes to 2e-14;
-the coding was a quarter of the tracker's update time).
-
-lambda (the paper gives no value; the tracker's default is 0.1): with zero-mean
-unit patches and 3 templates (147 atoms), lambda = 0.01 gave 35 non-zeros per
-patch and 22 ms per 49 patches, 0.1 gave 15 and 2.6 ms, 0.2 gave 10.6 and 1.4 ms
-(Bolt2, this machine, before the row-wise residual update), while the EMD's discrimination between target and
-background (benchmarks/tune_tracker.py --discrimination) stayed the same
-(17.6 % at 0.01 and 0.1, 16.7 % at 0.4).
+solved exactly by an active set (Lawson-Hanson on the quadratic program ``a'Ga - 2(b - lambda/2)'a``, numba), so
+the KKT conditions hold to rounding; the Cholesky factor of the active block is extended by a row per entering atom
+(docs/decisions.md#sparse-coding-solver).
 """
 from __future__ import annotations
 
@@ -71,10 +50,7 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
     Lawson-Hanson active set on the quadratic program a'Ga - 2(b - lambda/2)'a,
     from an empty support.  The Cholesky factor of the active block is extended by
     one row when an atom enters (O(k^2)) and rebuilt only when the step toward the
-    new solution drops atoms.  (Starting from the support of the target patch's
-    code gave the same codes 10 % slower: a window moved by a pixel codes
-    onto different atoms, and the wrong guesses cost solves to prune.)
-    ``ridge`` (1e-10) keeps the active sub-system solvable when two atoms are
+    new solution drops atoms.  ``ridge`` (1e-10) keeps the active sub-system solvable when two atoms are
     identical (e.g. replicated border padding in two templates); it changes the
     KKT residual by ridge * |a|, far below any tolerance that matters.
     """

@@ -1,26 +1,16 @@
 """Discriminative evidence of the window's position: a correlation filter over a search region (DSST/MOSSE).
 
-Why the tracker needs it: the iEMD histograms are a generative model with no notion of background.
-Where the target turns or is partly hidden, a window on background or on a similar object can score
-an EMD as low as the target's (Jogging-1: 0.40-0.58 on the target, 0.55 on the post that hides it),
-so the EMD alone cannot choose between the starting points that Algorithm 1 descends from.  A
-correlation filter is trained on the target against its own surroundings, the complementary view.
+The iEMD histograms are a generative model with no notion of background: where the target turns or is partly
+hidden, a window on background or on a similar object can score an EMD as low as the target's, so the EMD alone
+cannot choose between the starting points Algorithm 1 descends from.  A correlation filter trained on the target
+against its own surroundings is the complementary view (docs/decisions.md#translation-filter).
 
-The filter is DSST's translation filter (Danelljan et al., BMVC 2014; MOSSE with several channels):
-the window padded by ``padding`` on each axis is resampled to about ``model_area`` pixels and
-described by the gradient-orientation histograms of :func:`iemd_ros.tracking.correlation_filter.orientation_histograms`
-(cells of 4 model pixels), tapered by a Hann window; the desired response is a Gaussian of ``sigma_factor``
-times the target's size (in cells) at the window centre.  ``estimate`` gives the displacement where
-the response peaks and keeps the response map, which ``response_at`` reads at any window centre.  The
-tracker (``TrackerConfig.translation_weight``) takes the displacement as one more start and the response
-as evidence against the EMD when it chooses among the descended starts.
-
-Choices, measured over the 12 OTB sequences x 5 starts with every start descended (mean average overlap
-40.0 % with these defaults, 35.8 % without the filter): padding 1.5 (2.0: 38.1 %), learning rate 0.025
-(0.05 / 0.012: 37.7 / 36.1 %), sigma_factor 0.1 (DSST's 1/16: 35.8 %, 0.2: 38.0 %), model area 4096 px
-(2048 / 8192: 40.2 / 37.1 %).  With the defaults of 2026-11-23 (the default search scoring 38.6 %) learning
-rates 0.015 / 0.04 scored 35.0 / 36.3 %.
-Estimate and update take about 1 ms per frame together.
+The filter is DSST's translation filter (Danelljan et al., BMVC 2014; MOSSE with several channels): the window
+padded by ``padding`` on each axis is resampled to about ``model_area`` pixels and described by the
+gradient-orientation histograms of :func:`iemd_ros.tracking.correlation_filter.orientation_histograms` (cells of 4
+model pixels), tapered by a Hann window; the desired response is a Gaussian of ``sigma_factor`` times the target's
+size (in cells) at the window centre.  ``estimate`` gives the displacement where the response peaks and keeps the
+response map, which ``response_at`` reads at any window centre.
 """
 from __future__ import annotations
 
