@@ -49,7 +49,13 @@ class BagError(ValueError):
 
 
 def ros2_typestore():
-    """ROS 2 Jazzy typestore with the vision_msgs definitions registered."""
+    """ROS 2 Jazzy typestore with the vision_msgs definitions registered.
+
+    Returns
+    -------
+    rosbags.typesys.store.Typestore
+        The typestore.
+    """
     from rosbags.typesys import Stores, get_typestore
 
     from iemd_ros.bags.types import vision_msgs_types
@@ -60,7 +66,13 @@ def ros2_typestore():
 
 
 def ros1_typestore():
-    """ROS 1 Noetic typestore (Image, Imu, CameraInfo with ``D``/``K``/``R``/``P`` and ``Header.seq``)."""
+    """ROS 1 Noetic typestore (Image, Imu, CameraInfo with ``D``/``K``/``R``/``P`` and ``Header.seq``).
+
+    Returns
+    -------
+    rosbags.typesys.store.Typestore
+        The typestore.
+    """
     from rosbags.typesys import Stores, get_typestore
 
     return get_typestore(Stores.ROS1_NOETIC)
@@ -71,9 +83,23 @@ FORMATS = ("mcap", "sqlite3", "ros1")
 
 
 class BagWriter:
-    """Write one bag: ``fmt`` is ``mcap`` / ``sqlite3`` (rosbag2 version 9 folder) or ``ros1`` (.bag file).
+    """Write one bag.
 
-    Use as a context manager; on an exception the partial bag is removed.  ``custom_data`` (rosbag2 only) goes into ``metadata.yaml``.
+    Use as a context manager; on an exception the partial bag is removed.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The new bag: a rosbag2 folder, or a ``.bag`` file for ``ros1``.
+    fmt : {"mcap", "sqlite3", "ros1"}, optional
+        ``mcap`` / ``sqlite3`` (rosbag2 version 9 folder) or ``ros1`` (.bag file).
+    custom_data : dict, optional
+        Goes into ``metadata.yaml`` (rosbag2 only).
+
+    Raises
+    ------
+    BagError
+        For an unknown format, an output that exists already, or a ROS 1 path not ending in ``.bag``.
     """
 
     def __init__(self, path, fmt: str = "mcap", custom_data: dict | None = None):
@@ -103,6 +129,7 @@ class BagWriter:
 
     @property
     def ros1(self) -> bool:
+        """Whether the bag is a ROS 1 ``.bag``."""
         return self.fmt == "ros1"
 
     def __enter__(self) -> BagWriter:
@@ -121,20 +148,62 @@ class BagWriter:
         return result
 
     def msg(self, msgtype: str):
-        """Message class of ``msgtype`` in this bag's typestore."""
+        """Message class of ``msgtype`` in this bag's typestore.
+
+        Parameters
+        ----------
+        msgtype : str
+            Full type name (``sensor_msgs/msg/Image``).
+
+        Returns
+        -------
+        type
+            The message class.
+        """
         return self.typestore.types[msgtype]
 
     def add_topic(self, topic: str, msgtype: str) -> None:
+        """Add a topic of ``msgtype`` to the bag.
+
+        Parameters
+        ----------
+        topic : str
+            The topic's name.
+        msgtype : str
+            Full type name of its messages.
+        """
         self._conns[topic] = self._writer.add_connection(topic, msgtype, typestore=self.typestore)
         self.counts[topic] = 0
 
     def next_seq(self, topic: str) -> int:
-        """ROS 1 ``Header.seq`` of the next message on ``topic``."""
+        """ROS 1 ``Header.seq`` of the next message on ``topic``.
+
+        Parameters
+        ----------
+        topic : str
+            The topic's name.
+
+        Returns
+        -------
+        int
+            The sequence number, counting from 0.
+        """
         s = self._seq.get(topic, 0)
         self._seq[topic] = s + 1
         return s
 
     def write(self, topic: str, log_time_ns: int, message) -> None:
+        """Serialize ``message`` and write it on ``topic`` at a log time.
+
+        Parameters
+        ----------
+        topic : str
+            A topic added by :meth:`add_topic`.
+        log_time_ns : int
+            The log (receive) time, ns.
+        message : object
+            A message of this bag's typestore (:meth:`msg`).
+        """
         conn = self._conns[topic]
         ser = self.typestore.serialize_ros1 if self.ros1 else self.typestore.serialize_cdr
         self._writer.write(conn, int(log_time_ns), ser(message, conn.msgtype))
@@ -142,7 +211,13 @@ class BagWriter:
 
 
 class BagMessages:
-    """A :class:`~iemd_ros.messages.outputs.MessageFactory` of a rosbag2 writer's typestore."""
+    """A :class:`~iemd_ros.messages.outputs.MessageFactory` of a rosbag2 writer's typestore.
+
+    Parameters
+    ----------
+    bag : BagWriter
+        The writer whose typestore builds the messages.
+    """
 
     def __init__(self, bag: BagWriter):
         self._types = bag.typestore.types
@@ -152,11 +227,40 @@ class BagMessages:
 
     @staticmethod
     def byte(value: int) -> int:
+        """The value of a ``byte`` field: an int for rosbags.
+
+        Parameters
+        ----------
+        value : int
+            The byte's value.
+
+        Returns
+        -------
+        int
+            ``value``.
+        """
         return int(value)
 
 
 def header(bag: BagWriter, topic: str, stamp_ns: int, frame_id: str):
-    """``std_msgs/Header`` with ``stamp_ns`` (ROS 1: plus the per-topic ``seq``)."""
+    """``std_msgs/Header`` with ``stamp_ns`` (ROS 1: plus the per-topic ``seq``).
+
+    Parameters
+    ----------
+    bag : BagWriter
+        The bag whose typestore builds the header.
+    topic : str
+        The topic it is for (ROS 1 ``seq``).
+    stamp_ns : int
+        The stamp, ns.
+    frame_id : str
+        The header's frame.
+
+    Returns
+    -------
+    std_msgs/Header
+        The header.
+    """
     sec, nsec = ns_to_stamp(stamp_ns)
     stamp = bag.msg("builtin_interfaces/msg/Time")(sec=sec, nanosec=nsec)
     if bag.ros1:
@@ -165,14 +269,43 @@ def header(bag: BagWriter, topic: str, stamp_ns: int, frame_id: str):
 
 
 def camera_info_fields(ros1: bool, d, k, r, p) -> dict:
-    """CameraInfo matrix fields under their ROS 1 (``D K R P``) or ROS 2 (``d k r p``) names."""
+    """CameraInfo matrix fields under their ROS 1 (``D K R P``) or ROS 2 (``d k r p``) names.
+
+    Parameters
+    ----------
+    ros1 : bool
+        Use the ROS 1 names.
+    d, k, r, p : array_like
+        Distortion coefficients, camera, rectification and projection matrices.
+
+    Returns
+    -------
+    dict
+        Field name -> flat float64 array.
+    """
     names = ("D", "K", "R", "P") if ros1 else ("d", "k", "r", "p")
     return dict(zip(names, (np.asarray(v, dtype=np.float64).ravel() for v in (d, k, r, p))))
 
 
 # ---------------------------------------------------------------------------------------------- reading
 def resolve_bag_path(path) -> Path:
-    """The path AnyReader takes: a ``.bag`` file or a rosbag2 folder (also from its metadata/storage file)."""
+    """The path AnyReader takes: a ``.bag`` file or a rosbag2 folder (also from its metadata/storage file).
+
+    Parameters
+    ----------
+    path : str or path-like
+        A ``.bag`` file, a rosbag2 folder, or its ``metadata.yaml``, ``.mcap`` or ``.db3`` file.
+
+    Returns
+    -------
+    Path
+        The ``.bag`` file or the rosbag2 folder.
+
+    Raises
+    ------
+    BagError
+        For a path that does not exist or is neither.
+    """
     p = Path(path)
     if not p.exists():
         raise BagError(f"bag {p} does not exist")
@@ -202,7 +335,23 @@ def _reader_errors() -> tuple:
 
 
 def open_bag(path):
-    """Open a bag with rosbags' AnyReader; returns the open reader (close it, or use ``with``)."""
+    """Open a bag with rosbags' AnyReader.
+
+    Parameters
+    ----------
+    path : str or path-like
+        As :func:`resolve_bag_path` takes it.
+
+    Returns
+    -------
+    rosbags.highlevel.AnyReader
+        The open reader (close it, or use ``with``).
+
+    Raises
+    ------
+    BagError
+        For a bag that is missing, truncated or corrupt.
+    """
     from rosbags.highlevel import AnyReader
 
     p = resolve_bag_path(path)
@@ -215,7 +364,27 @@ def open_bag(path):
 
 
 def iter_messages(reader, connections, path="bag") -> Iterator[tuple[object, int, bytes]]:
-    """``reader.messages(connections)``; a read error (truncated/corrupt storage) becomes a BagError."""
+    """``reader.messages(connections)``; a read error (truncated/corrupt storage) becomes a BagError.
+
+    Parameters
+    ----------
+    reader : rosbags.highlevel.AnyReader
+        An open reader.
+    connections : list
+        The connections to read.
+    path : str or path-like, optional
+        The bag's name in the error message.
+
+    Yields
+    ------
+    tuple
+        (connection, log time ns, raw message bytes), in log-time order.
+
+    Raises
+    ------
+    BagError
+        For truncated or corrupt storage.
+    """
     it = reader.messages(connections=connections)
     while True:
         try:
@@ -228,6 +397,29 @@ def iter_messages(reader, connections, path="bag") -> Iterator[tuple[object, int
 
 
 def deserialize(reader, raw: bytes, msgtype: str, path="bag"):
+    """Decode a raw message.
+
+    Parameters
+    ----------
+    reader : rosbags.highlevel.AnyReader
+        The open reader it was read with.
+    raw : bytes
+        The serialized message.
+    msgtype : str
+        Its full type name.
+    path : str or path-like, optional
+        The bag's name in the error message.
+
+    Returns
+    -------
+    object
+        The message.
+
+    Raises
+    ------
+    BagError
+        For a message that cannot be decoded.
+    """
     try:
         return reader.deserialize(raw, msgtype)
     except _reader_errors() as exc:
@@ -236,7 +428,17 @@ def deserialize(reader, raw: bytes, msgtype: str, path="bag"):
 
 @dataclass(frozen=True)
 class Topics:
-    """Topics chosen for replay; ``imu``/``camera_info`` are None when the bag has none."""
+    """Topics chosen for replay; ``imu``/``camera_info`` are None when the bag has none.
+
+    Parameters
+    ----------
+    image : str
+        The image topic (``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage``).
+    imu : str or None
+        The IMU topic.
+    camera_info : str or None
+        The camera-info topic.
+    """
 
     image: str
     imu: str | None
@@ -281,7 +483,26 @@ def _image_candidates(topics: dict, images: list[str]) -> list[str]:
 
 def select_topics(reader, image: str | None = None, imu: str | None = None,
                   camera_info: str | None = None) -> Topics:
-    """Choose the image, IMU and camera-info topics of an open reader (see module docstring)."""
+    """Choose the image, IMU and camera-info topics of an open reader (see module docstring).
+
+    Parameters
+    ----------
+    reader : rosbags.highlevel.AnyReader
+        An open reader.
+    image, imu, camera_info : str, optional
+        The topics to use (default: auto-detected).
+
+    Returns
+    -------
+    Topics
+        The topics chosen.
+
+    Raises
+    ------
+    BagError
+        For a named topic missing or of the wrong type, an ambiguous choice, no image topic, or an image topic with no
+        message.
+    """
     topics = reader.topics
     img = _pick(topics, IMAGE_TYPES, image, "image", True, narrow=_image_candidates)
     if topics[img].msgcount == 0:
@@ -291,7 +512,18 @@ def select_topics(reader, image: str | None = None, imu: str | None = None,
 
 
 def custom_data(reader) -> dict:
-    """rosbag2 ``custom_data`` of an open reader ({} for ROS 1 bags)."""
+    """rosbag2 ``custom_data`` of an open reader.
+
+    Parameters
+    ----------
+    reader : rosbags.highlevel.AnyReader
+        An open reader.
+
+    Returns
+    -------
+    dict
+        Key -> value; {} for ROS 1 bags.
+    """
     out: dict = {}
     for r in getattr(reader, "readers", []):
         md = getattr(getattr(r, "storage", None), "metadata", None)
@@ -300,7 +532,19 @@ def custom_data(reader) -> dict:
 
 
 class Progress:
-    """A one-line progress bar on stderr (only when stderr is a terminal; ``enabled`` overrides)."""
+    """A one-line progress bar on stderr (only when stderr is a terminal; ``enabled`` overrides).
+
+    Parameters
+    ----------
+    total : int
+        Number of steps (0: no bar).
+    label : str, optional
+        Text before the bar.
+    enabled : bool, optional
+        Show the bar (default: when the stream is a terminal).
+    stream : file, optional
+        Where the bar goes (default ``sys.stderr``).
+    """
 
     def __init__(self, total: int, label: str = "", enabled: bool | None = None, stream=None):
         self.stream = stream if stream is not None else sys.stderr
@@ -308,6 +552,15 @@ class Progress:
         self.total, self.label, self.n, self._last = int(total), label, 0, -1
 
     def update(self, n: int = 1, note: str = "") -> None:
+        """Advance the bar.
+
+        Parameters
+        ----------
+        n : int, optional
+            Steps done.
+        note : str, optional
+            Text after the bar.
+        """
         self.n += n
         if not self.enabled:
             return
@@ -320,6 +573,7 @@ class Progress:
         self.stream.flush()
 
     def close(self) -> None:
+        """End the bar's line."""
         if self.enabled:
             self.stream.write("\n")
             self.stream.flush()

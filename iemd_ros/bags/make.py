@@ -72,8 +72,30 @@ _BASE_NS = 1_000_000_000   # stamps of frame-rate-only sources start at 1 s (0 o
 class BagSource:
     """What goes into a bag.  Stamps are integer ns; ``imu_t_ns`` is on the IMU clock.
 
-    ``read_frame(i, grey)`` returns frame ``i`` as BGR (or grey) uint8.  ``time_offset_ns`` is t_d
-    (``t_imu = t_cam + t_d``).  ``imu_frame_id`` None: the gyro is in the camera frame.
+    Parameters
+    ----------
+    name : str
+        The source's name.
+    frame_stamps_ns : ndarray
+        (N,) frame stamps, camera clock.
+    read_frame : callable
+        ``read_frame(i, grey)`` returns frame ``i`` as BGR (or grey) uint8.
+    camera : CameraModel, optional
+        The calibration (None: no camera info).
+    imu_t_ns : ndarray, optional
+        (M,) IMU stamps, IMU clock.
+    gyro : ndarray, optional
+        (M, 3) rates, rad/s.
+    accel : ndarray, optional
+        (M, 3) accelerations, m/s^2.
+    time_offset_ns : int, optional
+        The offset t_d (``t_imu = t_cam + t_d``).
+    imu_frame_id : str, optional
+        ``frame_id`` of the IMU samples; None: the gyro is in the camera frame.
+    gt_boxes : ndarray, optional
+        (N, 4) 0-based ground truth.
+    gt_flags : ndarray, optional
+        (N,) flags of the ground truth.
     """
 
     name: str
@@ -93,6 +115,7 @@ class BagSource:
 
     @property
     def has_imu(self) -> bool:
+        """Whether the source has IMU samples."""
         return self.imu_t_ns is not None and len(self.imu_t_ns) > 0
 
 
@@ -133,7 +156,36 @@ def _read_table(path: Path, min_cols: int, what: str) -> tuple[np.ndarray, np.nd
 
 def source_from_folder(folder, fps: float | None = None, stamps=None, imu_csv=None, camera_yaml=None,
                        time_offset_ms: float | None = None, imu_frame_id: str = IMU_FRAME) -> BagSource:
-    """Detect and load a source folder (see module docstring)."""
+    """Detect and load a source folder (see module docstring).
+
+    Parameters
+    ----------
+    folder : str or path-like
+        A CMU or phone recording, an OTB sequence or a folder of images.
+    fps : float, optional
+        Frame rate of a source without stamps (default 30).
+    stamps : str or path-like, optional
+        File of one time in seconds per line, one line per image.
+    imu_csv : str or path-like, optional
+        ``t_s, wx, wy, wz[, ax, ay, az]`` rows (rad/s, m/s^2).
+    camera_yaml : str or path-like, optional
+        ROS camera_info YAML (for a recording: used instead of its own calibration).
+    time_offset_ms : float, optional
+        The offset t_d of ``imu_csv``, ms (``t_imu = t_cam + t_d``).
+    imu_frame_id : str, optional
+        ``frame_id`` of the ``imu_csv`` samples.
+
+    Returns
+    -------
+    BagSource
+        The source.
+
+    Raises
+    ------
+    ValueError
+        For a folder that is none of these, options that do not apply to a known recording, stamps that do not match
+        the images or do not increase strictly, or files that cannot be read.
+    """
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f"source {folder} is not a folder")
@@ -179,8 +231,27 @@ def source_from_folder(folder, fps: float | None = None, stamps=None, imu_csv=No
 
 
 def source_from_synthetic(seq, imu_frame_id: str = IMU_FRAME) -> BagSource:
-    """A :class:`~iemd_ros.datasets.synthetic.SyntheticSequence` (rendered) as a bag source (gyro in the IMU
-    frame, ``R_cam_imu`` of the sequence; identity by default)."""
+    """A rendered :class:`~iemd_ros.datasets.synthetic.SyntheticSequence` as a bag source.
+
+    The gyro is in the IMU frame, ``R_cam_imu`` of the sequence (identity by default).
+
+    Parameters
+    ----------
+    seq : SyntheticSequence
+        The sequence.
+    imu_frame_id : str, optional
+        ``frame_id`` of the IMU samples when ``R_cam_imu`` is not the identity (else they are in the camera frame).
+
+    Returns
+    -------
+    BagSource
+        The source, with the sequence's ground truth.
+
+    Raises
+    ------
+    ValueError
+        For a sequence generated with ``render=False``.
+    """
     if seq.frames is None:
         raise ValueError("the synthetic sequence was generated with render=False: no frames to write")
 
@@ -258,11 +329,51 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
               count: int | None = None, imu_margin_s: float = 0.5, topics: dict | None = None,
               frame_id: str = CAMERA_FRAME, gt_out=None, progress: Callable[[int], None] | None = None,
               compress: str | None = None, jpeg_quality: int | None = None) -> dict:
-    """Write frames ``first .. first+count-1`` of ``source`` (with camera info and the IMU samples
-    within ``imu_margin_s`` of them) into a new bag ``out``.  Returns a summary dict (message counts,
-    the image topic, the IMU shift applied, the frame range).  ``gt_out``: also write the frames' ground
-    truth there (OTB text, 1-based; the desk flags kept as a 5th column).  ``compress`` ``"jpeg"`` /
-    ``"png"``: CompressedImage on the image topic + ``/compressed`` (module docstring)."""
+    """Write frames ``first .. first+count-1`` of ``source`` into a new bag ``out``.
+
+    With camera info and the IMU samples within ``imu_margin_s`` of the frames, stamped and logged as the module
+    docstring says.
+
+    Parameters
+    ----------
+    source : BagSource
+        What goes into the bag.
+    out : str or path-like
+        The new bag.
+    fmt : {"mcap", "sqlite3", "ros1"}, optional
+        The bag's format.
+    encoding : {"bgr8", "mono8"}, optional
+        Encoding of the images.
+    first : int, optional
+        The first frame.
+    count : int, optional
+        Number of frames (default: to the last).
+    imu_margin_s : float, optional
+        IMU samples this close to the first/last frame are kept, s.
+    topics : dict, optional
+        ``image``, ``camera_info``, ``imu`` topic names replacing :data:`DEFAULT_TOPICS`.
+    frame_id : str, optional
+        ``frame_id`` of the images and camera info (and of a gyro in the camera frame).
+    gt_out : str or path-like, optional
+        Also write the frames' ground truth there (OTB text, 1-based; the desk flags kept as a 5th column).
+    progress : callable, optional
+        Called with 1 for every image written.
+    compress : {"jpeg", "png"}, optional
+        CompressedImage on the image topic + ``/compressed`` (module docstring).
+    jpeg_quality : int, optional
+        JPEG quality, 1-100, with ``compress="jpeg"`` only.
+
+    Returns
+    -------
+    dict
+        A summary: message counts, the image topic, the IMU shift applied, the frame range.
+
+    Raises
+    ------
+    ValueError
+        For bad options, a frame range outside the source, no IMU sample near the frames, no ground truth for
+        ``gt_out``, or images whose size is not the calibration's or the first one's (the partial bag is removed).
+    """
     if encoding not in ENCODINGS:
         raise ValueError(f"encoding must be one of {', '.join(ENCODINGS)}, got {encoding!r}")
     if jpeg_quality is not None and compress != "jpeg":
@@ -270,32 +381,15 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
     quality = JPEG_QUALITY if jpeg_quality is None else jpeg_quality
     if compress is not None:
         check_compression(compress, quality)  # before the bag is opened
-    n = len(source)
-    if not 0 <= first < n:
-        raise ValueError(f"--first {first} is outside the {n} frames of {source.name}")
-    last = n if count is None else first + int(count)
-    if count is not None and (count < 1 or last > n):
-        raise ValueError(f"--count {count} from frame {first} exceeds the {n} frames of {source.name}")
+    last = _last_frame(source, first, count)
     if imu_margin_s < 0:
         raise ValueError(f"--imu-margin must be >= 0 s, got {imu_margin_s}")
     if gt_out is not None and source.gt_boxes is None:
         raise ValueError(f"{source.name} has no ground truth to write to {gt_out}")
-    tp = dict(DEFAULT_TOPICS, **(topics or {}))
-    if compress is not None:
-        if is_compressed_topic(tp["image"]):
-            raise ValueError(f"--image-topic {tp['image']} ends in /compressed: give the raw topic, --compress "
-                             "appends /compressed as image_transport does")
-        tp["image"] = compressed_topic(tp["image"])
+    tp = _topics(topics, compress)
     frame_t = np.asarray(source.frame_stamps_ns[first:last], dtype=np.int64)
     shift = -int(source.time_offset_ns)                    # IMU clock -> camera clock
-    imu_idx = imu_t = None
-    if source.has_imu:
-        t_cam = np.asarray(source.imu_t_ns, dtype=np.int64) + shift
-        margin = int(round(imu_margin_s * 1e9))
-        imu_idx = np.nonzero((t_cam >= frame_t[0] - margin) & (t_cam <= frame_t[-1] + margin))[0]
-        if len(imu_idx) == 0:
-            raise ValueError(f"{source.name}: no IMU sample within {imu_margin_s} s of the frames")
-        imu_t = t_cam[imu_idx]
+    imu_idx, imu_t = _imu_window(source, frame_t, shift, imu_margin_s)
     first_img = source.read_frame(first, encoding == "mono8")
     h, w = first_img.shape[:2]
     if source.camera is not None and source.camera.width is not None \
@@ -305,13 +399,21 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
     meta = {f"{META_PREFIX}source": source.name, f"{META_PREFIX}frames": f"{first}:{last}",
             f"{META_PREFIX}imu_time_shift_ns": str(shift if source.has_imu else 0),
             f"{META_PREFIX}stamps": "header stamps on the camera clock; IMU already shifted (replay t_d = 0)"}
-    imu_frame = source.imu_frame_id or frame_id
     with BagWriter(out, fmt, meta) as bag:
         bag.add_topic(tp["image"], IMAGE_TYPE if compress is None else COMPRESSED_IMAGE_TYPE)
         if source.camera is not None:
             bag.add_topic(tp["camera_info"], CAMERA_INFO_TYPE)
         if imu_t is not None:
             bag.add_topic(tp["imu"], IMU_TYPE)
+
+        def image(i: int):
+            img = first_img if i == 0 else source.read_frame(first + i, encoding == "mono8")
+            if img.shape[:2] != (h, w):
+                raise ValueError(f"frame {first + i} is {img.shape[1]}x{img.shape[0]}, the first one {w}x{h}")
+            args = (bag, tp["image"], int(frame_t[i]), frame_id, img)
+            return _image_msg(*args, encoding) if compress is None else _compressed_msg(*args, compress, quality)
+
+        imu_frame = source.imu_frame_id or frame_id
         for log_t, kind, i in _schedule(frame_t, imu_t, source.camera is not None):
             if kind == 0:
                 j = imu_idx[i]
@@ -321,12 +423,7 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
                 bag.write(tp["camera_info"], log_t,
                           _camera_info_msg(bag, tp["camera_info"], int(frame_t[i]), frame_id, source.camera, w, h))
             else:
-                img = first_img if i == 0 else source.read_frame(first + i, encoding == "mono8")
-                if img.shape[:2] != (h, w):
-                    raise ValueError(f"frame {first + i} is {img.shape[1]}x{img.shape[0]}, the first one {w}x{h}")
-                args = (bag, tp["image"], int(frame_t[i]), frame_id, img)
-                bag.write(tp["image"], log_t, _image_msg(*args, encoding) if compress is None
-                          else _compressed_msg(*args, compress, quality))
+                bag.write(tp["image"], log_t, image(i))
                 if progress is not None:
                     progress(1)
     if gt_out is not None:
@@ -337,9 +434,55 @@ def write_bag(source: BagSource, out, fmt: str = "mcap", encoding: str = "bgr8",
                 imu_time_shift_ns=shift if imu_t is not None else 0, counts=dict(bag.counts))
 
 
+def _last_frame(source: BagSource, first: int, count: int | None) -> int:
+    """One past the last frame of the range; ValueError naming ``--first``/``--count`` outside the source."""
+    n = len(source)
+    if not 0 <= first < n:
+        raise ValueError(f"--first {first} is outside the {n} frames of {source.name}")
+    last = n if count is None else first + int(count)
+    if count is not None and (count < 1 or last > n):
+        raise ValueError(f"--count {count} from frame {first} exceeds the {n} frames of {source.name}")
+    return last
+
+
+def _topics(topics: dict | None, compress: str | None) -> dict:
+    """The bag's topics: the defaults, overridden, the image topic + ``/compressed`` when compressing."""
+    tp = dict(DEFAULT_TOPICS, **(topics or {}))
+    if compress is not None:
+        if is_compressed_topic(tp["image"]):
+            raise ValueError(f"--image-topic {tp['image']} ends in /compressed: give the raw topic, --compress "
+                             "appends /compressed as image_transport does")
+        tp["image"] = compressed_topic(tp["image"])
+    return tp
+
+
+def _imu_window(source: BagSource, frame_t: np.ndarray, shift: int, margin_s: float):
+    """(indices, camera-clock stamps) of the IMU samples within ``margin_s`` of the frames; (None, None)
+    without IMU."""
+    if not source.has_imu:
+        return None, None
+    t_cam = np.asarray(source.imu_t_ns, dtype=np.int64) + shift
+    margin = int(round(margin_s * 1e9))
+    idx = np.nonzero((t_cam >= frame_t[0] - margin) & (t_cam <= frame_t[-1] + margin))[0]
+    if len(idx) == 0:
+        raise ValueError(f"{source.name}: no IMU sample within {margin_s} s of the frames")
+    return idx, t_cam[idx]
+
+
 def write_gt(path, boxes: np.ndarray, flags=None) -> None:
-    """Ground truth as 1-based ``x,y,w,h`` lines (``NaN`` where absent; the flag as a 5th column if given),
-    readable by :func:`iemd_ros.datasets.otb.parse_groundtruth` (``with_flags=True`` for the 5th column)."""
+    """Ground truth as 1-based ``x,y,w,h`` lines.
+
+    Readable by :func:`iemd_ros.datasets.otb.parse_groundtruth` (``with_flags=True`` for the 5th column).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file written.
+    boxes : ndarray
+        (N, 4) 0-based boxes; ``NaN`` is written where absent (a box with a non-finite value).
+    flags : sequence of str, optional
+        The flags, as a 5th column if given.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("w", newline="") as f:

@@ -55,8 +55,29 @@ HARDWARE_ID = "iemd_replay"
 
 @dataclass
 class ReplayResult:
-    """Per-image results (the init frame's has ``is_init``; frames skipped with ``drop_stamps`` have none) and run
-    statistics."""
+    """Per-image results and run statistics.
+
+    Parameters
+    ----------
+    bag : str
+        The bag replayed.
+    topics : Topics
+        The topics used.
+    results : list of FrameResult
+        One per image (the init frame's has ``is_init``; frames skipped with ``drop_stamps`` have none).
+    wall_s : float
+        Wall time of the whole replay (reading, decoding, tracking, writing), s.
+    track_s : float
+        Sum of the tracker's processing_ms (updates), s.
+    warnings : list of str, optional
+        The warnings given.
+    diagnostics : dict, optional
+        The pipeline's :meth:`~iemd_ros.pipeline.TrackingPipeline.diagnostics` at the end of the replay.
+    dropped : list of int, optional
+        Stamps skipped on request (``drop_stamps``).
+    init_s : float, optional
+        Time of the tracker's init on the first frame (one-off), s.
+    """
 
     bag: str
     topics: Topics
@@ -75,6 +96,7 @@ class ReplayResult:
 
     @property
     def stamps_ns(self) -> np.ndarray:
+        """(N,) stamps of the results, int64."""
         return np.array([r.stamp_ns for r in self.results], dtype=np.int64)
 
     @property
@@ -92,12 +114,28 @@ class ReplayResult:
 
     @property
     def gyro_used(self) -> int:
+        """Number of frames tracked with the gyro prior."""
         return sum(r.gyro_used for r in self.results)
 
 
 def parse_box(box) -> tuple[float, float, float, float]:
-    """The init box: ``"X,Y,W,H"`` or a sequence of 4 numbers -> 4 floats (finite, w, h > 0); ValueError
-    (naming ``--init``) otherwise."""
+    """The init box as 4 floats.
+
+    Parameters
+    ----------
+    box : str or sequence of 4 float
+        ``"X,Y,W,H"`` or 4 numbers.
+
+    Returns
+    -------
+    tuple of float
+        (x, y, w, h), finite with w, h > 0.
+
+    Raises
+    ------
+    ValueError
+        Naming ``--init``, for anything else.
+    """
     return check_box(box.split(",") if isinstance(box, str) else box, "--init", shown=box)
 
 
@@ -106,7 +144,18 @@ def _fmt(v) -> str:
 
 
 def csv_rows(results: list[FrameResult]):
-    """The CSV rows of :data:`CSV_HEADER` of ``results``."""
+    """The CSV rows of :data:`CSV_HEADER` of ``results``.
+
+    Parameters
+    ----------
+    results : list of FrameResult
+        Per-image results.
+
+    Yields
+    ------
+    list of str
+        One row per result (see the module docstring).
+    """
     for r in results:
         box = r.box if r.box is not None else (None,) * 4
         if r.is_init:
@@ -120,6 +169,15 @@ def csv_rows(results: list[FrameResult]):
 
 
 def write_csv(path, results: list[FrameResult]) -> None:
+    """Write the CSV of ``results``: :data:`CSV_HEADER`, then :func:`csv_rows`.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file written (its folder is created if needed).
+    results : list of FrameResult
+        Per-image results.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     with path.open("w", newline="") as f:
@@ -202,13 +260,15 @@ class Replay:
     Parameters
     ----------
     bag : path
-        rosbag2 folder (or its ``metadata.yaml`` / storage file) or ROS 1 ``.bag``.
+        A rosbag2 folder (or its ``metadata.yaml`` / storage file) or ROS 1 ``.bag``.
     init_box : str or sequence of 4 float
         ``"X,Y,W,H"`` or 4 numbers (:func:`parse_box`): the target on the first decodable image.
     image_topic, imu_topic, camera_info_topic : str, optional
         Topics to use (default: the bag's one topic of each type).
     config : PipelineConfig, optional
         Default ``PipelineConfig()``; ``use_gyro=False`` disables the prior (``--no-gyro``).
+    use_gyro : bool, optional
+        False disables the prior as well.
     camera : CameraModel, optional
         Calibration to use instead of the bag's camera info.
     warn : callable, optional
@@ -260,7 +320,30 @@ class Replay:
         self._warn(text)
 
     def run(self, csv_path=None, out_bag=None, video=None, progress: bool | None = None) -> ReplayResult:
-        """Replay the whole bag, writing the outputs asked for (partial output files are removed on an error)."""
+        """Replay the whole bag, writing the outputs asked for (partial output files are removed on an error).
+
+        Parameters
+        ----------
+        csv_path : str or path-like, optional
+            The CSV of the results.
+        out_bag : str or path-like, optional
+            A new rosbag2 (mcap) of the detections and diagnostics.
+        video : str or path-like, optional
+            An annotated MP4.
+        progress : bool, optional
+            Show a progress bar (default: when stderr is a terminal).
+
+        Returns
+        -------
+        ReplayResult
+            The results and the run's statistics.
+
+        Raises
+        ------
+        ValueError
+            A :class:`~iemd_ros.bags.io.BagError` for a bag found truncated or corrupt while reading, or without a
+            decodable image; a ValueError naming ``--init`` for an init box the first image refuses.
+        """
         self._results: list[FrameResult] = []
         self._dropped: list[int] = []
         self._pending: deque[_Frame] = deque()
@@ -376,5 +459,24 @@ class Replay:
 
 def replay(bag, init_box, *, csv_path=None, out_bag=None, video=None, progress: bool | None = None,
            **options) -> ReplayResult:
-    """``Replay(bag, init_box, **options).run(csv_path, out_bag, video, progress)``."""
+    """``Replay(bag, init_box, **options).run(csv_path, out_bag, video, progress)``.
+
+    Parameters
+    ----------
+    bag : path
+        As :class:`Replay` takes it.
+    init_box : str or sequence of 4 float
+        As :class:`Replay` takes it.
+    csv_path, out_bag, video : str or path-like, optional
+        The outputs, as :meth:`Replay.run` takes them.
+    progress : bool, optional
+        As :meth:`Replay.run` takes it.
+    **options
+        The other arguments of :class:`Replay`.
+
+    Returns
+    -------
+    ReplayResult
+        The results and the run's statistics.
+    """
     return Replay(bag, init_box, **options).run(csv_path, out_bag, video, progress)

@@ -24,7 +24,14 @@ REPO_MSG_DIR = Path(__file__).resolve().parents[1] / "interfaces" / PACKAGE / "m
 
 
 def vision_msgs_msg_dirs() -> list[Path]:
-    """Candidate folders of vision_msgs ``.msg`` files, most authoritative first."""
+    """Candidate folders of vision_msgs ``.msg`` files, most authoritative first.
+
+    Returns
+    -------
+    list of Path
+        ``share/vision_msgs/msg`` of each prefix in AMENT_PREFIX_PATH and of this interpreter's prefix, then the
+        repository's ``interfaces/vision_msgs/msg``.
+    """
     prefixes = [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
     prefixes.append(Path(sys.prefix))
     dirs = [prefix / "share" / PACKAGE / "msg" for prefix in prefixes]
@@ -33,7 +40,18 @@ def vision_msgs_msg_dirs() -> list[Path]:
 
 
 def find_vision_msgs_msg_dir() -> Path:
-    """First folder of ``vision_msgs_msg_dirs()`` that holds ``.msg`` files."""
+    """First folder of ``vision_msgs_msg_dirs()`` that holds ``.msg`` files.
+
+    Returns
+    -------
+    Path
+        The folder.
+
+    Raises
+    ------
+    FileNotFoundError
+        When none holds them.
+    """
     searched = vision_msgs_msg_dirs()
     for folder in searched:
         if folder.is_dir() and any(folder.glob("*.msg")):
@@ -45,8 +63,22 @@ def find_vision_msgs_msg_dir() -> Path:
 def vision_msgs_types(msg_dir: str | os.PathLike | None = None) -> dict:
     """Parse every ``vision_msgs/msg/*.msg`` into ``{type name: definition}`` for rosbags.
 
-    ``msg_dir``: folder of the ``.msg`` files; default ``find_vision_msgs_msg_dir()``.
-    Raises ValueError when an explicit ``msg_dir`` is not a folder or holds no ``.msg`` file.
+    Parameters
+    ----------
+    msg_dir : str or path-like, optional
+        Folder of the ``.msg`` files; default ``find_vision_msgs_msg_dir()``.
+
+    Returns
+    -------
+    dict
+        Type name -> definition, as ``Typestore.register`` takes it.
+
+    Raises
+    ------
+    ValueError
+        When an explicit ``msg_dir`` is not a folder or holds no ``.msg`` file.
+    FileNotFoundError
+        When no ``msg_dir`` is given and no folder holds the definitions.
     """
     from rosbags.typesys import get_types_from_msg
 

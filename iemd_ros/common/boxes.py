@@ -12,20 +12,63 @@ __all__ = ["box_centre", "centre_box", "check_box", "map_points"]
 
 
 def box_centre(box) -> np.ndarray:
-    """Centre ``(x + (w-1)/2, y + (h-1)/2)`` of (..., 4) boxes."""
+    """Centre ``(x + (w-1)/2, y + (h-1)/2)`` of boxes.
+
+    Parameters
+    ----------
+    box : array_like
+        (..., 4) boxes (x, y, w, h).
+
+    Returns
+    -------
+    ndarray
+        (..., 2) centres, pixel-index coordinates.
+    """
     b = np.asarray(box, dtype=float)
     return b[..., :2] + (b[..., 2:] - 1.0) / 2.0
 
 
 def centre_box(centre, size) -> np.ndarray:
-    """Inverse of :func:`box_centre`: (..., 4) boxes of the given centres and ``(w, h)`` sizes."""
+    """Inverse of :func:`box_centre`: boxes of the given centres and sizes.
+
+    Parameters
+    ----------
+    centre : array_like
+        (..., 2) centres, pixel-index coordinates.
+    size : array_like
+        (..., 2) sizes ``(w, h)``.
+
+    Returns
+    -------
+    ndarray
+        (..., 4) boxes (x, y, w, h).
+    """
     c, s = np.asarray(centre, dtype=float), np.asarray(size, dtype=float)
     return np.concatenate([c - (s - 1.0) / 2.0, s], axis=-1)
 
 
 def check_box(box, what: str = "box", shown=None) -> tuple[float, float, float, float]:
-    """``box`` as 4 floats ``(x, y, w, h)``, finite with ``w, h > 0``; else ValueError naming ``what``
-    and quoting ``shown`` (default: ``box``), e.g. the text the values were parsed from."""
+    """``box`` as 4 floats ``(x, y, w, h)``, finite with ``w, h > 0``.
+
+    Parameters
+    ----------
+    box : array_like
+        The values to check.
+    what : str, optional
+        What the error message names.
+    shown : optional
+        What the error message quotes (default: ``box``), e.g. the text the values were parsed from.
+
+    Returns
+    -------
+    tuple of float
+        (x, y, w, h).
+
+    Raises
+    ------
+    ValueError
+        Naming ``what`` and quoting ``shown``, for anything else.
+    """
     shown = box if shown is None else shown
     try:
         b = np.asarray(box, dtype=float).ravel()
@@ -41,6 +84,19 @@ def check_box(box, what: str = "box", shown=None) -> tuple[float, float, float, 
 
 
 def map_points(H, points) -> np.ndarray:
-    """(..., 2) pixel points mapped by the 3x3 homography ``H``."""
+    """Pixel points mapped by a homography.
+
+    Parameters
+    ----------
+    H : ndarray
+        3x3 homography.
+    points : array_like
+        (..., 2) pixel points.
+
+    Returns
+    -------
+    ndarray
+        (..., 2) mapped points.
+    """
     ph = np.asarray(points, dtype=float) @ H[:, :2].T + H[:, 2]
     return ph[..., :2] / ph[..., 2:3]

@@ -9,29 +9,84 @@ __all__ = ["CliParser", "UsageError", "cli_main", "one_line", "split_ros_args"]
 
 
 class UsageError(Exception):
+    """A command-line usage error (:meth:`CliParser.error`), which :func:`cli_main` reports in one line."""
     pass
 
 
 class CliParser(argparse.ArgumentParser):
+    """``argparse.ArgumentParser`` whose errors raise :class:`UsageError` instead of printing the usage and exiting.
+
+    It takes the parameters of :class:`argparse.ArgumentParser`.
+    """
+
     def error(self, message: str):  # one readable line, exit 2 (no usage dump)
+        """Report a usage error as one readable line, exit 2 (no usage dump), through :func:`cli_main`.
+
+        Parameters
+        ----------
+        message : str
+            The error.
+
+        Raises
+        ------
+        UsageError
+            Always, with ``message``.
+        """
         raise UsageError(message)
 
 
 def one_line(exc: BaseException) -> str:
-    """An exception's message on one line of at most 300 characters."""
+    """An exception's message on one line of at most 300 characters.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The exception.
+
+    Returns
+    -------
+    str
+        Its message with the whitespace collapsed (its type's name when empty), cut with "..." at 300 characters.
+    """
     text = " ".join(str(exc).split()) or type(exc).__name__
     return text if len(text) < 300 else text[:297] + "..."
 
 
 def split_ros_args(argv: list[str] | None) -> tuple[list[str], list[str]]:
-    """(own arguments, ``--ros-args ...`` tail) of ``argv`` (default ``sys.argv[1:]``), as ``ros2 run`` passes them."""
+    """Split ``argv`` into the command's own arguments and the ``--ros-args ...`` tail, as ``ros2 run`` passes them.
+
+    Parameters
+    ----------
+    argv : list of str or None
+        The arguments (default ``sys.argv[1:]``).
+
+    Returns
+    -------
+    own : list of str
+        The arguments before ``--ros-args``.
+    ros : list of str
+        ``--ros-args`` and the arguments after it (empty without it).
+    """
     args = list(sys.argv[1:] if argv is None else argv)
     cut = args.index("--ros-args") if "--ros-args" in args else len(args)
     return args[:cut], args[cut:]
 
 
 def cli_main(prog: str, body: Callable[[], int]) -> int:
-    """Run ``body``; bad arguments / files (ValueError, OSError, usage errors) -> one stderr line, exit 2."""
+    """Run ``body``; bad arguments / files (ValueError, OSError, usage errors) -> one stderr line, exit 2.
+
+    Parameters
+    ----------
+    prog : str
+        The command's name, which starts the error line.
+    body : callable
+        The command; returns its exit status.
+
+    Returns
+    -------
+    int
+        ``body``'s exit status, 2 for bad input, 130 when interrupted.
+    """
     try:
         return body()
     except (UsageError, ValueError, OSError) as exc:

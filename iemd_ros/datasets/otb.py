@@ -29,7 +29,19 @@ IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
 
 @dataclass(frozen=True)
 class Sequence:
-    """One OTB target: its frames (in order) and 0-based ``(x, y, w, h)`` GT boxes, shape (N, 4)."""
+    """One OTB target: its frames (in order) and 0-based ``(x, y, w, h)`` GT boxes.
+
+    Parameters
+    ----------
+    name : str
+        The target's name (``Jogging-1`` for one target of a multi-target folder).
+    frame_paths : tuple of Path
+        Its images, in frame-number order.
+    gt_boxes : ndarray
+        (N, 4) GT boxes, all NaN where the target is absent.
+    frame_numbers : tuple of int, optional
+        Frame numbers, from the file names.
+    """
 
     name: str
     frame_paths: tuple[Path, ...]
@@ -40,19 +52,62 @@ class Sequence:
         return len(self.frame_paths)
 
     def head(self, n: int) -> "Sequence":
-        """The first ``n`` frames (all of them when ``n`` >= len)."""
+        """The first ``n`` frames (all of them when ``n`` >= len).
+
+        Parameters
+        ----------
+        n : int
+            Number of frames, >= 1.
+
+        Returns
+        -------
+        Sequence
+            The shortened sequence.
+
+        Raises
+        ------
+        ValueError
+            For ``n`` < 1.
+        """
         if n < 1:
             raise ValueError(f"{self.name}: number of frames must be >= 1, got {n}")
         return Sequence(self.name, self.frame_paths[:n], self.gt_boxes[:n], self.frame_numbers[:n])
 
     def frames(self) -> Iterator[np.ndarray]:
-        """Yield the frames as BGR uint8 arrays (grayscale JPEGs come back 3-channel)."""
+        """The frames as BGR uint8 arrays (grayscale JPEGs come back 3-channel).
+
+        Yields
+        ------
+        ndarray
+            HxWx3 uint8 frames, in order.
+
+        Raises
+        ------
+        ValueError
+            For an image that cannot be decoded.
+        """
         for path in self.frame_paths:
             yield read_frame(path)
 
 
 def read_frame(path: str | Path) -> np.ndarray:
-    """Read one image with OpenCV (BGR uint8, HxWx3); ValueError if it cannot be decoded."""
+    """Read one image with OpenCV.
+
+    Parameters
+    ----------
+    path : str or Path
+        The image file.
+
+    Returns
+    -------
+    ndarray
+        BGR uint8, HxWx3.
+
+    Raises
+    ------
+    ValueError
+        If it cannot be decoded.
+    """
     img = cv2.imread(str(path))
     if img is None:
         raise ValueError(f"cannot read image {path}")
@@ -60,12 +115,29 @@ def read_frame(path: str | Path) -> np.ndarray:
 
 
 def parse_groundtruth(path: str | Path, with_flags: bool = False):
-    """Parse a GT file into 0-based ``(x, y, w, h)`` boxes, shape (N, 4) float.
+    r"""Parse a GT file into 0-based ``(x, y, w, h)`` boxes.
 
-    Each non-empty line is split on ``[,\\s]+`` and must hold exactly four numbers; a box with a
-    non-finite value ("NaN") marks an absent target and becomes all NaN.  With ``with_flags`` a line
-    may carry a 5th flag column (default "ok"; "absent" also gives a NaN box) and ``(boxes, flags)``
-    is returned, flags an (N,) str array.
+    Each non-empty line is split on ``[,\s]+`` and must hold exactly four numbers; a box with a non-finite value
+    ("NaN") marks an absent target and becomes all NaN.
+
+    Parameters
+    ----------
+    path : str or Path
+        The GT file, 1-based boxes.
+    with_flags : bool, optional
+        A line may carry a 5th flag column (default "ok"; "absent" also gives a NaN box), and the flags are returned.
+
+    Returns
+    -------
+    boxes : ndarray
+        (N, 4) float boxes.
+    flags : ndarray
+        (N,) str array; only with ``with_flags``.
+
+    Raises
+    ------
+    ValueError
+        For a file that cannot be read, has no box, or a line that is not four numbers (and the optional flag).
     """
     path = Path(path)
     try:
@@ -125,12 +197,40 @@ def _gt_files(folder: Path) -> dict[str, Path]:
 
 
 def is_sequence_folder(folder: str | Path) -> bool:
+    """Whether ``folder`` is an OTB sequence folder.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The folder.
+
+    Returns
+    -------
+    bool
+        True when it has an ``img/`` folder and a ``groundtruth_rect.txt`` (or ``groundtruth_rect.<k>.txt`` files).
+    """
     folder = Path(folder)
     return (folder / "img").is_dir() and bool(_gt_files(folder))
 
 
 def list_sequences(root: str | Path) -> list[str]:
-    """Names of the OTB targets below ``root``, sorted (Jogging gives Jogging-1 and Jogging-2)."""
+    """Names of the OTB targets below ``root``, sorted (Jogging gives Jogging-1 and Jogging-2).
+
+    Parameters
+    ----------
+    root : str or Path
+        The OTB root folder.
+
+    Returns
+    -------
+    list of str
+        The target names.
+
+    Raises
+    ------
+    ValueError
+        If ``root`` is not a directory.
+    """
     root = Path(root)
     if not root.is_dir():
         raise ValueError(f"OTB root {root} is not a directory")
@@ -142,7 +242,13 @@ def list_sequences(root: str | Path) -> list[str]:
 
 
 def default_root() -> Path | None:
-    """``../shared/data/otb`` beside the repository (or beside the working directory), if it exists."""
+    """``../shared/data/otb`` beside the repository (or beside the working directory), if it exists.
+
+    Returns
+    -------
+    Path or None
+        The folder; None when neither exists.
+    """
     here = Path(__file__).resolve().parents[1]
     for base in (here, Path.cwd()):
         cand = base.parent / "shared" / "data" / "otb"
@@ -169,7 +275,26 @@ def _resolve(path_or_name: str | Path, root: str | Path | None) -> tuple[Path, s
 
 
 def load_sequence(path_or_name: str | Path, root: str | Path | None = None) -> Sequence:
-    """Load one target from a sequence folder, ``<folder>-<k>`` (multi-target) or a name under ``root``."""
+    """Load one target.
+
+    Parameters
+    ----------
+    path_or_name : str or Path
+        A sequence folder, ``<folder>-<k>`` (one target of a multi-target folder) or a name under ``root``.
+    root : str or Path, optional
+        The OTB root of a bare name (default: :func:`default_root`).
+
+    Returns
+    -------
+    Sequence
+        The target's frames and GT.
+
+    Raises
+    ------
+    ValueError
+        When the sequence is not found or not an OTB sequence, names a target the folder does not hold, or has a number
+        of GT boxes other than its number of images.
+    """
     folder, name = _resolve(path_or_name, root)
     paths, numbers = _frames_of(folder)
     gts = _gt_files(folder)

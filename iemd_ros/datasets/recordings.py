@@ -33,7 +33,33 @@ CMU_TIME_OFFSET_NS = -20_000_000
 
 @dataclass
 class Recording:
-    """One recording; ``gyro`` is in the camera frame (so ``R_cam_imu`` is the identity)."""
+    """One recording; ``gyro`` is in the camera frame (so ``R_cam_imu`` is the identity).
+
+    Parameters
+    ----------
+    name : str
+        The recording's name.
+    root : Path
+        Its folder.
+    frame_files : list of Path
+        The frame images, in order.
+    frame_stamps_ns : ndarray
+        Frame stamps, camera clock, int64.
+    time_offset_ns : int
+        ``t_imu = t_cam + time_offset_ns``.
+    imu_t_ns : ndarray
+        Gyro stamps, IMU clock, int64, original row order.
+    gyro : ndarray
+        (M, 3) rad/s, camera frame.
+    camera : CameraModel
+        The calibration.
+    accel : ndarray, optional
+        (M, 3) accelerometer samples, where recorded.
+    gt_boxes : ndarray, optional
+        (N, 4) 0-based x, y, w, h; NaN where absent.
+    gt_flags : ndarray, optional
+        (N,) str flags of the GT.
+    """
 
     name: str
     root: Path
@@ -56,20 +82,58 @@ class Recording:
         return self.frame_stamps_ns + self.time_offset_ns
 
     def gyro_config(self, time_offset_ns: int | None = None) -> GyroConfig:
-        """Gyro settings for this recording: its time offset (or ``time_offset_ns``) and a buffer
-        that holds the whole gyro record."""
+        """Gyro settings for this recording: its time offset and a buffer that holds the whole gyro record.
+
+        Parameters
+        ----------
+        time_offset_ns : int, optional
+            Time offset to use instead of the recording's.
+
+        Returns
+        -------
+        GyroConfig
+            The settings.
+        """
         offset = self.time_offset_ns if time_offset_ns is None else time_offset_ns
         return GyroConfig(time_offset_ns=offset, buffer_ns=10 ** 13, buffer_samples=10 ** 7)
 
     def gyro_predictor(self, time_offset_ns: int | None = None) -> GyroPredictor:
-        """A :class:`GyroPredictor` holding the whole gyro record, with the recording's camera and
-        :meth:`gyro_config`."""
+        """A :class:`GyroPredictor` holding the whole gyro record, with the recording's camera and :meth:`gyro_config`.
+
+        Parameters
+        ----------
+        time_offset_ns : int, optional
+            Time offset to use instead of the recording's.
+
+        Returns
+        -------
+        GyroPredictor
+            The predictor, fed every gyro sample.
+        """
         pred = GyroPredictor(self.camera, self.gyro_config(time_offset_ns))
         pred.add_imu(self.imu_t_ns, self.gyro)
         return pred
 
     def load_frame(self, i: int, grey: bool = False) -> np.ndarray:
-        """Frame ``i`` (0-based) as BGR uint8 (or grey)."""
+        """Frame ``i`` as BGR uint8 (or grey).
+
+        Parameters
+        ----------
+        i : int
+            Frame index, 0-based.
+        grey : bool, optional
+            Read it as HxW grey levels.
+
+        Returns
+        -------
+        ndarray
+            HxWx3 BGR or HxW grey uint8.
+
+        Raises
+        ------
+        ValueError
+            If the image cannot be read.
+        """
         path = self.frame_files[i]
         img = cv2.imread(str(path), cv2.IMREAD_GRAYSCALE if grey else cv2.IMREAD_COLOR)
         if img is None:
@@ -82,6 +146,23 @@ def _ms_to_ns(v) -> np.ndarray:
 
 
 def seconds_to_ns(text: str) -> int:
+    """A time in seconds, written in decimal, as integer nanoseconds, parsed exactly from the text.
+
+    Parameters
+    ----------
+    text : str
+        The time in seconds.
+
+    Returns
+    -------
+    int
+        Nanoseconds.
+
+    Raises
+    ------
+    ValueError
+        For text that is not a number.
+    """
     try:
         return int((Decimal(text.strip()) * 1_000_000_000).to_integral_value())
     except InvalidOperation as exc:
@@ -101,7 +182,24 @@ def _rows(path: Path) -> list[list[str]]:
 
 
 def load_cmu(root) -> Recording:
-    """Load ``cmu_hwangbo_desk`` or ``cmu_hwangbo_aerial`` (the sequence name comes from ``*_img.log``)."""
+    """Load ``cmu_hwangbo_desk`` or ``cmu_hwangbo_aerial`` (the sequence name comes from ``*_img.log``).
+
+    Parameters
+    ----------
+    root : str or path-like
+        The recording's folder.
+
+    Returns
+    -------
+    Recording
+        With the authors' offset :data:`CMU_TIME_OFFSET_NS`, the accelerometer and, if present, the desk ground truth.
+
+    Raises
+    ------
+    ValueError
+        For missing or inconsistent files: not one ``*_img.log``, frame names not ending in ``_<t_ms>.jpg``,
+        ``derived_frames.csv`` disagreeing with the log, IMU rows without 7 columns, GT of another length.
+    """
     root = Path(root)
     logs = sorted(root.glob("*_img.log"))
     if len(logs) != 1:
@@ -135,7 +233,23 @@ def load_cmu(root) -> Recording:
 
 
 def load_phone(root) -> Recording:
-    """Load the phone sequence (``derived_frames.csv``, ``derived_gyro_camframe.csv``, ``derived_camera.yaml``)."""
+    """Load the phone sequence (``derived_frames.csv``, ``derived_gyro_camframe.csv``, ``derived_camera.yaml``).
+
+    Parameters
+    ----------
+    root : str or path-like
+        The recording's folder.
+
+    Returns
+    -------
+    Recording
+        With the fitted time offset of ``derived_camera.yaml``.
+
+    Raises
+    ------
+    ValueError
+        For a missing file or a calibration that cannot be read.
+    """
     import yaml
 
     root = Path(root)
@@ -156,7 +270,23 @@ def load_phone(root) -> Recording:
 
 
 def load_recording(path) -> Recording:
-    """Load a recording folder of either kind (CMU or phone), detected from its files."""
+    """Load a recording folder of either kind (CMU or phone), detected from its files.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The recording's folder.
+
+    Returns
+    -------
+    Recording
+        As :func:`load_cmu` or :func:`load_phone` loads it.
+
+    Raises
+    ------
+    ValueError
+        For a path that is not a folder of either kind, or as the loaders raise.
+    """
     root = Path(path)
     if not root.is_dir():
         raise ValueError(f"not a recording folder: {root}")

@@ -38,7 +38,55 @@ _FACES = [np.eye(3)] + [so3_exp(np.array(v) * np.pi / 2) for v in
 
 @dataclass
 class SyntheticConfig:
-    """Parameters of :func:`generate` (angles in degrees, rates in deg/s unless noted)."""
+    """Parameters of :func:`generate` (angles in degrees, rates in deg/s unless noted).
+
+    Parameters
+    ----------
+    width, height : int
+        Image size, px.
+    hfov_deg : float
+        Horizontal field of view.
+    dist : tuple of float
+        The plumb_bob lens [k1 k2 p1 p2 k3].
+    fps : float
+        Frame rate, Hz.
+    n_frames : int
+        Number of frames.
+    motion : {"shake", "pan", "still"}
+        The camera's motion.
+    max_rate_deg_s : float
+        Peak |w| (shake) or the constant rate (pan).
+    shake_freqs_hz : tuple of float
+        Per-axis sinusoid frequencies (randomised +-20 %).
+    shake_axis_weights : tuple of float
+        Weights of x (tilt), y (pan), z (roll).
+    pan_axis : tuple of float
+        Axis of the pan, camera frame.
+    target_size_px : float
+        Side of the square target near the image centre.
+    target_speed_deg_s : float
+        Peak speed of the target on the scene sphere (0: it stays put).
+    target_offset_deg : tuple of float
+        Initial target direction (azimuth, elevation).
+    gyro_rate_hz : float
+        Gyro sample rate.
+    gyro_noise_std : float
+        White gyro noise, rad/s per sample.
+    gyro_bias : tuple of float
+        Gyro bias, rad/s, IMU frame.
+    gyro_jitter_s : float
+        Standard deviation of the gyro stamp jitter, s.
+    time_offset_s : float
+        ``t_imu = t_cam + time_offset``, s.
+    still_start_s : float
+        The camera is still this long (s) before the motion ramps in.
+    R_cam_imu : ndarray
+        3x3 IMU -> camera rotation.
+    seed : int
+        Everything is deterministic from it.
+    render : bool
+        False: ground truth and gyro only (``frames`` is None).
+    """
 
     width: int = 320
     height: int = 240
@@ -65,6 +113,14 @@ class SyntheticConfig:
     render: bool = True                            # False: ground truth and gyro only (frames is None)
 
     def validate(self) -> None:
+        """Check the parameters.
+
+        Raises
+        ------
+        ValueError
+            For width or height below 16, fewer than 2 frames, fps <= 0, an unknown motion, hfov_deg outside [10, 120],
+            gyro_rate_hz <= 0, negative noise, jitter or still_start_s, or target_size_px <= 2.
+        """
         if self.width < 16 or self.height < 16 or self.n_frames < 2 or self.fps <= 0:
             raise ValueError(f"need width, height >= 16, n_frames >= 2 and fps > 0, got "
                              f"{self.width}x{self.height}, {self.n_frames} frames at {self.fps} fps")
@@ -80,7 +136,39 @@ class SyntheticConfig:
 
 @dataclass
 class SyntheticSequence:
-    """Output of :func:`generate`; stamps in ns, gyro in the IMU frame (rad/s)."""
+    """Output of :func:`generate`; stamps in ns, gyro in the IMU frame (rad/s).
+
+    Parameters
+    ----------
+    frames : ndarray or None
+        (N, H, W, 3) BGR uint8 (None when config.render is False).
+    frame_stamps_ns : ndarray
+        (N,) int64, camera clock.
+    gyro_t_ns : ndarray
+        (M,) int64, IMU clock.
+    gyro : ndarray
+        (M, 3) rad/s, IMU frame.
+    K : ndarray
+        3x3 camera matrix.
+    dist : ndarray
+        The (5,) plumb_bob coefficients.
+    R_cam_imu : ndarray
+        3x3 IMU -> camera rotation.
+    time_offset_ns : int
+        ``t_imu = t_cam + time_offset_ns``.
+    gyro_bias : ndarray
+        (3,) rad/s, IMU frame.
+    orientations : ndarray
+        (N, 3, 3) camera k in the world (camera 0) frame.
+    gt_boxes : ndarray
+        (N, 4) x, y, w, h (tracker box convention).
+    gt_centres : ndarray
+        (N, 2) image of the target centre (pixel-index coordinates).
+    visible : ndarray
+        (N,) target outline fully inside the image and in front.
+    config : SyntheticConfig
+        The parameters it was generated with.
+    """
 
     frames: np.ndarray | None     # (N, H, W, 3) BGR uint8 (None when config.render is False)
     frame_stamps_ns: np.ndarray   # (N,) int64, camera clock
@@ -99,10 +187,22 @@ class SyntheticSequence:
 
     @cached_property
     def camera(self) -> CameraModel:
+        """The camera model of the sequence (K, lens and image size)."""
         return CameraModel(self.K, self.dist, self.config.width, self.config.height, "synthetic")
 
     def relative_rotation(self, k: int) -> np.ndarray:
-        """True rotation of camera k in camera k-1."""
+        """True rotation of camera k in camera k-1.
+
+        Parameters
+        ----------
+        k : int
+            Frame index, >= 1.
+
+        Returns
+        -------
+        ndarray
+            3x3 rotation.
+        """
         return self.orientations[k - 1].T @ self.orientations[k]
 
 
@@ -138,7 +238,20 @@ def _rate_function(cfg: SyntheticConfig):
 
 
 def angular_velocity(cfg: SyntheticConfig, t_s) -> np.ndarray:
-    """True camera-frame body rate (rad/s) at true times ``t_s`` (frame 0 at t = 0), shape (..., 3)."""
+    """True camera-frame body rate at true times ``t_s`` (frame 0 at t = 0).
+
+    Parameters
+    ----------
+    cfg : SyntheticConfig
+        The sequence's parameters.
+    t_s : array_like
+        True times, s.
+
+    Returns
+    -------
+    ndarray
+        (..., 3) rates, rad/s.
+    """
     return _rate_function(cfg)(np.asarray(t_s, dtype=float))
 
 
@@ -268,7 +381,25 @@ class _Renderer:
 
 
 def generate(config: SyntheticConfig | None = None, **overrides) -> SyntheticSequence:
-    """Render a synthetic sequence; keyword overrides replace fields of ``config``."""
+    """Render a synthetic sequence.
+
+    Parameters
+    ----------
+    config : SyntheticConfig, optional
+        Default ``SyntheticConfig()``.
+    **overrides
+        Keyword overrides replace fields of ``config``.
+
+    Returns
+    -------
+    SyntheticSequence
+        Frames, gyro and ground truth.
+
+    Raises
+    ------
+    ValueError
+        For invalid parameters (:meth:`SyntheticConfig.validate`) or a lens that is not invertible over the image.
+    """
     cfg = SyntheticConfig() if config is None else config
     if overrides:
         cfg = SyntheticConfig(**{**cfg.__dict__, **overrides})

@@ -48,16 +48,45 @@ def _pair(boxes_a, boxes_b) -> tuple[np.ndarray, np.ndarray]:
 
 
 def valid_boxes(boxes) -> np.ndarray:
-    """Boolean mask of boxes that are finite and have positive width and height."""
+    """Boolean mask of boxes that are finite and have positive width and height.
+
+    Parameters
+    ----------
+    boxes : array_like
+        (x, y, w, h) or (N, 4) boxes.
+
+    Returns
+    -------
+    ndarray
+        (N,) bool.
+
+    Raises
+    ------
+    ValueError
+        For other shapes.
+    """
     b = _as_boxes(boxes, "boxes")
     with np.errstate(invalid="ignore"):
         return np.isfinite(b).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0)
 
 
 def iou(boxes_a, boxes_b) -> np.ndarray:
-    """Relative overlap ``|A ∩ B| / |A ∪ B|`` of paired boxes (paper's overlap equation), shape (N,).
+    """Relative overlap ``|A ∩ B| / |A ∪ B|`` of paired boxes (paper's overlap equation).
 
-    A single box broadcasts against N boxes.  Invalid boxes (NaN, w <= 0 or h <= 0) give 0.
+    Parameters
+    ----------
+    boxes_a, boxes_b : array_like
+        (x, y, w, h) or (N, 4) boxes; a single box broadcasts against N boxes.
+
+    Returns
+    -------
+    ndarray
+        (N,) overlaps; invalid boxes (NaN, w <= 0 or h <= 0) give 0.
+
+    Raises
+    ------
+    ValueError
+        For other shapes, or different numbers of boxes.
     """
     a, b = _pair(boxes_a, boxes_b)
     ok = valid_boxes(a) & valid_boxes(b)
@@ -71,7 +100,23 @@ def iou(boxes_a, boxes_b) -> np.ndarray:
 
 
 def center_error(boxes_a, boxes_b) -> np.ndarray:
-    """Euclidean distance in pixels between box centres, shape (N,); ``inf`` where a box is invalid."""
+    """Euclidean distance in pixels between box centres.
+
+    Parameters
+    ----------
+    boxes_a, boxes_b : array_like
+        (x, y, w, h) or (N, 4) boxes; a single box broadcasts against N boxes.
+
+    Returns
+    -------
+    ndarray
+        (N,) distances; ``inf`` where a box is invalid.
+
+    Raises
+    ------
+    ValueError
+        For other shapes, or different numbers of boxes.
+    """
     a, b = _pair(boxes_a, boxes_b)
     ok = valid_boxes(a) & valid_boxes(b)
     ca = a[:, :2] + a[:, 2:] / 2.0
@@ -91,35 +136,145 @@ def _as_values(values, name: str) -> np.ndarray:
 
 
 def fraction_above(ious, thr: float) -> float:
-    """Fraction of frames whose overlap is strictly greater than ``thr`` (paper: overlap > 0, > 40 %)."""
+    """Fraction of frames whose overlap is strictly greater than ``thr`` (paper: overlap > 0, > 40 %).
+
+    Parameters
+    ----------
+    ious : array_like
+        Per-frame overlaps.
+    thr : float
+        The threshold.
+
+    Returns
+    -------
+    float
+        The fraction, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For no values, or NaN among them.
+    """
     return float(np.mean(_as_values(ious, "ious") > thr))
 
 
 def success_curve(ious, thresholds=OTB_THRESHOLDS) -> np.ndarray:
-    """OTB success plot: for each threshold t, the fraction of frames with overlap > t."""
+    """OTB success plot: for each threshold t, the fraction of frames with overlap > t.
+
+    Parameters
+    ----------
+    ious : array_like
+        Per-frame overlaps.
+    thresholds : array_like, optional
+        The thresholds (default: the 21 of OTB).
+
+    Returns
+    -------
+    ndarray
+        One fraction per threshold.
+
+    Raises
+    ------
+    ValueError
+        For no values, or NaN among them.
+    """
     v = _as_values(ious, "ious")
     t = np.asarray(thresholds, dtype=float).ravel()
     return (v[None, :] > t[:, None]).mean(axis=1)
 
 
 def success_auc(ious, thresholds=OTB_THRESHOLDS) -> float:
-    """OTB area under the success curve: the mean of the curve over the (21) thresholds."""
+    """OTB area under the success curve: the mean of the curve over the (21) thresholds.
+
+    Parameters
+    ----------
+    ious : array_like
+        Per-frame overlaps.
+    thresholds : array_like, optional
+        The thresholds (default: the 21 of OTB).
+
+    Returns
+    -------
+    float
+        The area, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For no values, or NaN among them.
+    """
     return float(success_curve(ious, thresholds).mean())
 
 
 def precision_at(center_errors, thr: float = PRECISION_THRESHOLD) -> float:
-    """OTB precision: fraction of frames whose centre error is <= ``thr`` pixels (default 20)."""
+    """OTB precision: fraction of frames whose centre error is <= ``thr`` pixels.
+
+    Parameters
+    ----------
+    center_errors : array_like
+        Per-frame centre errors, px.
+    thr : float, optional
+        The threshold, px (default 20).
+
+    Returns
+    -------
+    float
+        The fraction, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For no values, or NaN among them.
+    """
     return float(np.mean(_as_values(center_errors, "center_errors") <= thr))
 
 
 def average_overlap(ious) -> float:
-    """The paper's table metric: mean relative overlap over all (scored) frames."""
+    """The paper's table metric: mean relative overlap over all (scored) frames.
+
+    Parameters
+    ----------
+    ious : array_like
+        Per-frame overlaps.
+
+    Returns
+    -------
+    float
+        The mean, in [0, 1].
+
+    Raises
+    ------
+    ValueError
+        For no values, or NaN among them.
+    """
     return float(np.mean(_as_values(ious, "ious")))
 
 
 @dataclass
 class SequenceScores:
-    """All per-sequence figures of one tracker run (fractions in [0, 1]; ``fps`` may be None)."""
+    """All per-sequence figures of one tracker run (fractions in [0, 1]; ``fps`` may be None).
+
+    Parameters
+    ----------
+    name : str
+        The sequence's name.
+    n_frames : int
+        Frames scored (GT present).
+    n_absent : int
+        Frames excluded because the GT box is invalid / NaN.
+    average_overlap : float
+        The paper's table metric.
+    success_auc : float
+        OTB area under the success curve.
+    precision_20 : float
+        OTB precision at 20 px.
+    overlap_gt_0, overlap_gt_04 : float
+        Fractions of frames with overlap > 0 and > 0.4.
+    fps : float or None, optional
+        The run's speed.
+    success_curve : list of float, optional
+        The success curve at :data:`OTB_THRESHOLDS`.
+    """
 
     name: str
     n_frames: int          # frames scored (GT present)
@@ -133,11 +288,38 @@ class SequenceScores:
     success_curve: list[float] = field(default_factory=list)
 
     def to_dict(self) -> dict:
+        """The figures as a dict.
+
+        Returns
+        -------
+        dict
+            Field name -> value (``dataclasses.asdict``).
+        """
         return asdict(self)
 
 
 def score_sequence(pred_boxes, gt_boxes, name: str = "", fps: float | None = None) -> SequenceScores:
-    """Score predicted boxes against ground truth over the frames where the GT box is valid."""
+    """Score predicted boxes against ground truth over the frames where the GT box is valid.
+
+    Parameters
+    ----------
+    pred_boxes, gt_boxes : array_like
+        (N, 4) predicted and GT boxes.
+    name : str, optional
+        The sequence's name.
+    fps : float, optional
+        The run's speed, recorded as it is.
+
+    Returns
+    -------
+    SequenceScores
+        The figures.
+
+    Raises
+    ------
+    ValueError
+        For boxes of other shapes or of different numbers, or no valid GT box.
+    """
     pred = _as_boxes(pred_boxes, "pred_boxes")
     gt = _as_boxes(gt_boxes, "gt_boxes")
     if len(pred) != len(gt):

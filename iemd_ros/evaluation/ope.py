@@ -41,40 +41,120 @@ MEAN = "mean"
 class TrackerAdapter(Protocol):
     """What the evaluation needs from a tracker: init on a box, then one box per frame."""
 
-    def init(self, frame: np.ndarray, box: np.ndarray) -> None: ...
+    def init(self, frame: np.ndarray, box: np.ndarray) -> None:
+        """Start tracking the target ``box`` on ``frame``.
+
+        Parameters
+        ----------
+        frame : ndarray
+            The first frame, BGR uint8.
+        box : ndarray
+            (x, y, w, h), float.
+        """
+        ...
 
     def update(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
-        """Return ``(box (x, y, w, h) float, ok)``; ``ok`` False when the tracker reports a failure."""
+        """Track into the next frame.
+
+        Parameters
+        ----------
+        frame : ndarray
+            The frame, BGR uint8.
+
+        Returns
+        -------
+        box : ndarray
+            (x, y, w, h), float.
+        ok : bool
+            False when the tracker reports a failure.
+        """
 
 
 class OpenCVTracker:
-    """Adapter for OpenCV's ``cv2.Tracker`` (integer boxes, ``update`` -> ``(ok, box)``)."""
+    """Adapter for OpenCV's ``cv2.Tracker`` (integer boxes, ``update`` -> ``(ok, box)``).
+
+    Parameters
+    ----------
+    create : callable
+        Returns a new ``cv2.Tracker``; called by every :meth:`init`.
+    """
 
     def __init__(self, create: Callable[[], "cv2.Tracker"]):
         self._create = create
         self._tracker = None
 
     def init(self, frame: np.ndarray, box: np.ndarray) -> None:
+        """Start a new OpenCV tracker on ``box``, rounded to integers (width and height at least 1).
+
+        Parameters
+        ----------
+        frame : ndarray
+            The first frame, BGR uint8.
+        box : ndarray
+            (x, y, w, h), float.
+        """
         self._tracker = self._create()
         x, y, w, h = (int(round(v)) for v in box)
         self._tracker.init(frame, (x, y, max(w, 1), max(h, 1)))
 
     def update(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Track into the next frame.
+
+        Parameters
+        ----------
+        frame : ndarray
+            The frame, BGR uint8.
+
+        Returns
+        -------
+        box : ndarray
+            (x, y, w, h), float.
+        ok : bool
+            False when the tracker reports a failure.
+        """
         ok, box = self._tracker.update(frame)
         return np.asarray(box, dtype=float), bool(ok)
 
 
 class IemdAdapter:
-    """Adapter for :class:`iemd_ros.IemdTracker` with a :class:`~iemd_ros.TrackerConfig` (None: the
-    defaults); no gyro prior in OTB."""
+    """Adapter for :class:`iemd_ros.IemdTracker`; no gyro prior in OTB.
+
+    Parameters
+    ----------
+    config : TrackerConfig, optional
+        The tracker's :class:`~iemd_ros.TrackerConfig` (None: the defaults).
+    """
 
     def __init__(self, config=None):
         self._tracker = IemdTracker(config)
 
     def init(self, frame: np.ndarray, box: np.ndarray) -> None:
+        """Start tracking the target ``box`` on ``frame``.
+
+        Parameters
+        ----------
+        frame : ndarray
+            The first frame, BGR uint8.
+        box : ndarray
+            (x, y, w, h), float.
+        """
         self._tracker.init(frame, tuple(float(v) for v in box))
 
     def update(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Track into the next frame.
+
+        Parameters
+        ----------
+        frame : ndarray
+            The frame, BGR uint8.
+
+        Returns
+        -------
+        box : ndarray
+            (x, y, w, h), float.
+        ok : bool
+            False when the tracker reports the target lost.
+        """
         result = self._tracker.update(frame)
         return np.asarray(result.box, dtype=float), not bool(result.lost)
 
@@ -105,8 +185,25 @@ TRACKERS: dict[str, Callable[..., TrackerAdapter]] = {
 
 
 def make_tracker(name: str, config=None) -> TrackerAdapter:
-    """Build a tracker adapter by name, with its ``config`` (None: the tracker's defaults); ValueError for
-    an unknown or unavailable tracker."""
+    """Build a tracker adapter by name.
+
+    Parameters
+    ----------
+    name : str
+        A name in :data:`TRACKERS`.
+    config : optional
+        The tracker's configuration (None: the tracker's defaults).
+
+    Returns
+    -------
+    TrackerAdapter
+        A fresh adapter.
+
+    Raises
+    ------
+    ValueError
+        For an unknown or unavailable tracker, or a configuration given to one that takes none.
+    """
     if name not in TRACKERS:
         raise ValueError(f"unknown tracker {name!r} (known: {', '.join(TRACKERS)})")
     return TRACKERS[name]() if config is None else TRACKERS[name](config)
@@ -114,7 +211,19 @@ def make_tracker(name: str, config=None) -> TrackerAdapter:
 
 @dataclass
 class RunResult:
-    """Boxes, failure flags and timings of one tracker on one sequence."""
+    """Boxes, failure flags and timings of one tracker on one sequence.
+
+    Parameters
+    ----------
+    boxes : ndarray
+        (N, 4), frame 0 = GT.
+    ok : ndarray
+        (N,) bool, frame 0 = True.
+    init_seconds : float
+        Time of the ``init`` call.
+    update_seconds : ndarray
+        (N - 1,) times of the ``update`` calls.
+    """
 
     boxes: np.ndarray        # (N, 4), frame 0 = GT
     ok: np.ndarray           # (N,) bool, frame 0 = True
@@ -123,6 +232,7 @@ class RunResult:
 
     @property
     def fps(self) -> float:
+        """Frames per second: frames / (init time + sum of update times)."""
         total = self.init_seconds + float(self.update_seconds.sum())
         return len(self.boxes) / total if total > 0 else float("inf")
 
@@ -130,7 +240,27 @@ class RunResult:
 def run_tracker(tracker: TrackerAdapter, frames, init_box) -> RunResult:
     """One-pass run: init on the first frame with ``init_box``, update on each later frame (timed).
 
-    An invalid returned box (empty, NaN) is replaced by the previous box (see module docstring)."""
+    An invalid returned box (empty, NaN) is replaced by the previous box (see module docstring).
+
+    Parameters
+    ----------
+    tracker : TrackerAdapter
+        A fresh tracker.
+    frames : iterable of ndarray
+        The sequence's frames.
+    init_box : array_like
+        (x, y, w, h) on the first frame.
+
+    Returns
+    -------
+    RunResult
+        The boxes, the trackers' ok flags and the timings.
+
+    Raises
+    ------
+    ValueError
+        When there is no frame.
+    """
     it = iter(frames)
     try:
         first = next(it)
@@ -152,13 +282,39 @@ def run_tracker(tracker: TrackerAdapter, frames, init_box) -> RunResult:
 
 
 def evaluate_sequence(seq: Sequence, tracker: TrackerAdapter) -> tuple[SequenceScores, RunResult]:
-    """One-pass run of a fresh ``tracker`` on ``seq`` and its scores."""
+    """One-pass run of a fresh ``tracker`` on ``seq`` and its scores.
+
+    Parameters
+    ----------
+    seq : Sequence
+        The sequence, initialised with its first GT box.
+    tracker : TrackerAdapter
+        A fresh tracker.
+
+    Returns
+    -------
+    scores : SequenceScores
+        The run's figures, fps included.
+    run : RunResult
+        The run.
+    """
     run = run_tracker(tracker, seq.frames(), seq.gt_boxes[0])
     return score_sequence(run.boxes, seq.gt_boxes, seq.name, fps=run.fps), run
 
 
 def mean_scores(scores: list[SequenceScores]) -> dict:
-    """Mean over sequences of every per-sequence figure (OTB's overall plot averages the curves)."""
+    """Mean over sequences of every per-sequence figure (OTB's overall plot averages the curves).
+
+    Parameters
+    ----------
+    scores : list of SequenceScores
+        One tracker's scores on the sequences.
+
+    Returns
+    -------
+    dict
+        The mean figures and success curve, ``n_sequences`` and the total ``n_frames``.
+    """
     keys = ("average_overlap", "success_auc", "precision_20", "overlap_gt_0", "overlap_gt_04", "fps")
     out = {k: float(np.mean([getattr(s, k) for s in scores])) for k in keys}
     out["success_curve"] = np.mean([s.success_curve for s in scores], axis=0).tolist()
@@ -168,7 +324,17 @@ def mean_scores(scores: list[SequenceScores]) -> dict:
 
 
 def plot_success(curves: dict[str, list[float]], title: str, path: Path) -> None:
-    """OTB-style success plot: one curve per tracker, legend ``name [AUC]`` sorted by AUC."""
+    """OTB-style success plot: one curve per tracker, legend ``name [AUC]`` sorted by AUC.
+
+    Parameters
+    ----------
+    curves : dict
+        Tracker name -> success curve at :data:`~iemd_ros.evaluation.metrics.OTB_THRESHOLDS`.
+    title : str
+        The plot's title.
+    path : Path
+        The PNG file written.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -190,6 +356,22 @@ def _pct(v: float) -> str:
 
 
 def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
+    """The results as a text table: one row per sequence and tracker, then one per tracker's mean.
+
+    Parameters
+    ----------
+    results : dict
+        Tracker -> sequence name (and ``mean``) -> figures, as :func:`evaluate` records them.
+    trackers : list of str
+        The trackers' names.
+    names : list of str
+        The sequences' names.
+
+    Returns
+    -------
+    str
+        The table, fractions in percent.
+    """
     header = f"{'sequence':<14} {'tracker':<7} {'frames':>6} {'AO%':>6} {'AUC%':>6} {'P@20%':>6} {'>0%':>6} {'>40%':>6} {'fps':>8}"
     lines = [header, "-" * len(header)]
 
@@ -209,8 +391,25 @@ def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
 
 
 def collect_sequences(inputs: list[str], wanted: list[str] | None) -> list[Sequence]:
-    """Load the sequences named by the CLI inputs (OTB roots, sequence folders or ``<folder>-<k>``
-    targets), keeping those in ``wanted`` (case-insensitive; ``Jogging`` selects Jogging-1 and -2)."""
+    """Load the sequences named by the CLI inputs.
+
+    Parameters
+    ----------
+    inputs : list of str
+        OTB roots, sequence folders or ``<folder>-<k>`` targets (none: ``../shared/data/otb``).
+    wanted : list of str or None
+        The targets kept (case-insensitive; ``Jogging`` selects Jogging-1 and -2); None: all.
+
+    Returns
+    -------
+    list of Sequence
+        The targets, in order.
+
+    Raises
+    ------
+    ValueError
+        For an input that is neither an OTB root nor a sequence, an unknown wanted name, or no root at all.
+    """
     return [load_sequence(name, root) for name, root in _select_targets(inputs, wanted).items()]
 
 
@@ -252,16 +451,45 @@ def _select_targets(inputs: list[str], wanted: list[str] | None) -> dict[str, Pa
 
 
 def sequence_names(wanted: str | None) -> list[str]:
-    """Names of the targets in ``../shared/data/otb`` chosen by a comma-separated list (as
-    :func:`collect_sequences`; empty or None: all), for scripts whose workers load them by name."""
+    """Names of the targets in ``../shared/data/otb`` chosen by a comma-separated list.
+
+    For scripts whose workers load them by name.
+
+    Parameters
+    ----------
+    wanted : str or None
+        Comma-separated names, as :func:`collect_sequences` takes them; empty or None: all.
+
+    Returns
+    -------
+    list of str
+        The target names.
+    """
     return list(_select_targets([], wanted.split(",") if wanted else None))
 
 
 def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, configs=None) -> dict:
     """Run every tracker on every sequence, write ``results.json`` and success plots into ``out``.
 
-    ``configs``: tracker name -> its configuration (:func:`make_tracker`; absent: the defaults).  The iEMD
-    configuration is recorded in ``results.json`` when iEMD runs.
+    The iEMD configuration is recorded in ``results.json`` when iEMD runs.
+
+    Parameters
+    ----------
+    sequences : list of Sequence
+        The sequences.
+    trackers : list of str
+        Names in :data:`TRACKERS`.
+    out : Path
+        The output folder, created if needed.
+    log : callable, optional
+        Receives one line per sequence and tracker.
+    configs : dict, optional
+        Tracker name -> its configuration (:func:`make_tracker`; absent: the defaults).
+
+    Returns
+    -------
+    dict
+        The document written to ``results.json``.
     """
     configs = configs or {}
     out.mkdir(parents=True, exist_ok=True)

@@ -12,11 +12,30 @@ def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True
                     config: TrackerConfig | None = None) -> tuple[list[FrameResult], list[str]]:
     """Track frames ``start+1 .. stop-1`` of ``rec`` from its GT box at ``start``, causally.
 
-    The frames and the whole gyro record go through a :class:`~iemd_ros.pipeline.pipeline.TrackingPipeline`,
-    so the priors are the node's: with ``use_gyro`` the prior for frame k is the lens-aware local
-    homography at the tracker's window, integrated from the frame that window belongs to (after a
-    frame reported lost the tracker keeps its previous window), and a prior the tracker refuses is
-    dropped for that frame.  Returns the results and one note per frame tracked without a gyro prior.
+    The frames and the whole gyro record go through a :class:`~iemd_ros.pipeline.pipeline.TrackingPipeline`, so the
+    priors are the node's: with ``use_gyro`` the prior for frame k is the lens-aware local homography at the tracker's
+    window, integrated from the frame that window belongs to (after a frame reported lost the tracker keeps its previous
+    window), and a prior the tracker refuses is dropped for that frame.
+
+    Parameters
+    ----------
+    rec : Recording
+        The recording, with ground truth at ``start``.
+    start : int
+        The frame the tracker starts on.
+    stop : int
+        One past the last frame tracked.
+    use_gyro : bool, optional
+        Use the gyro prior.
+    config : TrackerConfig, optional
+        The tracker's configuration (default ``TrackerConfig()``).
+
+    Returns
+    -------
+    results : list of FrameResult
+        One per frame tracked.
+    notes : list of str
+        One note per frame tracked without a gyro prior.
     """
     cfg = PipelineConfig(tracker=config if config is not None else TrackerConfig(), gyro=rec.gyro_config(),
                          use_gyro=use_gyro)

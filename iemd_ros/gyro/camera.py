@@ -29,7 +29,25 @@ def _field(info: dict, *names):
 
 
 class CameraModel:
-    """Intrinsics ``K`` (3x3), plumb_bob distortion ``D`` and image size."""
+    """Pinhole camera: intrinsics ``K`` (3x3), plumb_bob distortion ``D`` and image size.
+
+    Parameters
+    ----------
+    K : array_like
+        3x3 camera matrix, or its 9 values row-major: upper-triangular with fx, fy > 0 and last row [0, 0, 1].
+    D : array_like, optional
+        The plumb_bob coefficients [k1, k2, p1, p2, k3]: at most 5 finite values, the missing ones 0 (None: no
+        distortion).
+    width, height : int, optional
+        Image size in pixels, both or neither.
+    name : str, optional
+        The camera's name (camera_info's ``camera_name``).
+
+    Raises
+    ------
+    ValueError
+        For a ``K`` or ``D`` that is not so, or an image size that is not two positive integers.
+    """
 
     def __init__(self, K, D=None, width: int | None = None, height: int | None = None, name: str = ""):
         K = np.asarray(K, dtype=float)
@@ -56,8 +74,25 @@ class CameraModel:
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_camera_info(cls, info: dict) -> CameraModel:
-        """From a ROS camera_info YAML dict (``camera_matrix.data`` ...) or a CameraInfo-like dict
-        (``k``, ``d``, ``width``, ``height``, ``distortion_model``)."""
+        """Camera model of a camera_info dict.
+
+        Parameters
+        ----------
+        info : dict
+            A ROS camera_info YAML dict (``camera_matrix.data`` ...) or a CameraInfo-like dict (``k``, ``d``, ``width``,
+            ``height``, ``distortion_model``).
+
+        Returns
+        -------
+        CameraModel
+            The model of ``info``.
+
+        Raises
+        ------
+        ValueError
+            For a non-mapping, no camera matrix, a distortion model other than plumb_bob (or none) with non-zero
+            coefficients, or invalid values.
+        """
         if not isinstance(info, dict):
             raise ValueError(f"camera info must be a mapping, got {type(info).__name__}")
         K = _field(info, "camera_matrix", "k", "K")
@@ -73,7 +108,23 @@ class CameraModel:
 
     @classmethod
     def from_yaml(cls, path) -> CameraModel:
-        """Load a ROS camera_info-style YAML file."""
+        """Load a ROS camera_info-style YAML file.
+
+        Parameters
+        ----------
+        path : str or path-like
+            The YAML file.
+
+        Returns
+        -------
+        CameraModel
+            The model of the file (:meth:`from_camera_info`).
+
+        Raises
+        ------
+        ValueError
+            For a file that cannot be read or parsed, or invalid contents.
+        """
         import yaml
 
         path = Path(path)
@@ -84,7 +135,14 @@ class CameraModel:
         return cls.from_camera_info(info)
 
     def to_camera_info(self) -> dict:
-        """ROS camera_info-style dict (round-trips through :meth:`from_camera_info`)."""
+        """ROS camera_info-style dict, which round-trips through :meth:`from_camera_info`.
+
+        Returns
+        -------
+        dict
+            Image size, camera name, camera matrix, plumb_bob coefficients, rectification (identity) and projection
+            (``[K | 0]``) matrices.
+        """
         P = np.hstack([self.K, np.zeros((3, 1))])
         return dict(image_width=self.width, image_height=self.height, camera_name=self.name,
                     camera_matrix=dict(rows=3, cols=3, data=self.K.ravel().tolist()),
@@ -95,6 +153,7 @@ class CameraModel:
 
     @property
     def has_distortion(self) -> bool:
+        """Whether any distortion coefficient is non-zero."""
         return self._has_distortion
 
     # ------------------------------------------------------------------ points
@@ -119,15 +178,50 @@ class CameraModel:
         return xd.reshape(shape), yd.reshape(shape)
 
     def distort_points(self, pts) -> np.ndarray:
-        """Undistorted pixel coordinates (..., 2) -> distorted (raw image) pixel coordinates."""
+        """Undistorted pixel coordinates -> distorted (raw image) pixel coordinates.
+
+        Parameters
+        ----------
+        pts : array_like
+            (..., 2) undistorted pixels.
+
+        Returns
+        -------
+        ndarray
+            (..., 2) raw-image pixels (a copy of ``pts`` without distortion).
+
+        Raises
+        ------
+        ValueError
+            When the points' last axis is not 2.
+        """
         p = self._points(pts)
         if not self.has_distortion:
             return p.copy()
         return self._to_pix(*self._distort_norm(*self._to_norm(p)))
 
     def undistort_points(self, pts, iterations: int = 30, tol: float = 1e-12) -> np.ndarray:
-        """Distorted (raw image) pixels (..., 2) -> undistorted pixels, by Newton's method on the
-        plumb_bob model (converges to < 1e-6 px where the model is invertible; NaN where it fails)."""
+        """Distorted (raw image) pixels -> undistorted pixels, by Newton's method on the plumb_bob model.
+
+        Parameters
+        ----------
+        pts : array_like
+            (..., 2) raw-image pixels.
+        iterations : int, optional
+            Most Newton steps per point.
+        tol : float, optional
+            Step length (normalized coordinates) below which a point has converged.
+
+        Returns
+        -------
+        ndarray
+            (..., 2) undistorted pixels: converged to < 1e-6 px where the model is invertible, NaN where it fails.
+
+        Raises
+        ------
+        ValueError
+            When the points' last axis is not 2.
+        """
         p = self._points(pts)
         if not self.has_distortion:
             return p.copy()
@@ -138,7 +232,20 @@ class CameraModel:
 
     # ------------------------------------------------------------------ images
     def undistort_maps(self) -> tuple[np.ndarray, np.ndarray]:
-        """``cv2.remap`` maps (float32) giving, for each undistorted pixel, its raw-image position."""
+        """``cv2.remap`` maps giving, for each undistorted pixel, its raw-image position.
+
+        Returns
+        -------
+        map_x : ndarray
+            (height, width) float32 raw-image x of each pixel.
+        map_y : ndarray
+            (height, width) float32 raw-image y of each pixel.
+
+        Raises
+        ------
+        ValueError
+            When the camera has no image size.
+        """
         if self.width is None:
             raise ValueError("undistort_maps needs the image size (width/height) of the camera")
         u, v = np.meshgrid(np.arange(self.width, dtype=float), np.arange(self.height, dtype=float))
@@ -146,7 +253,20 @@ class CameraModel:
         return m[..., 0], m[..., 1]
 
     def undistort_image(self, image: np.ndarray, maps=None) -> np.ndarray:
-        """Undistorted image with the same K (pixels mapping outside the raw image are black)."""
+        """Undistorted image with the same K (pixels mapping outside the raw image are black).
+
+        Parameters
+        ----------
+        image : ndarray
+            Raw image.
+        maps : tuple of ndarray, optional
+            :meth:`undistort_maps`, if already computed.
+
+        Returns
+        -------
+        ndarray
+            The undistorted image.
+        """
         mx, my = self.undistort_maps() if maps is None else maps
         return cv2.remap(image, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
 

@@ -16,8 +16,17 @@ IDENTITY = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 
 @dataclass
 class GyroConfig:
-    """Parameters of :class:`~iemd_ros.gyro.predictor.GyroPredictor`; ``w_cam = R_cam_imu (w_imu - bias)`` and
-    ``t_imu = t_cam + time_offset_ns``.  ``R_cam_imu`` may be given as a 3x3 array, ``bias`` as an array."""
+    """Parameters of :class:`~iemd_ros.gyro.predictor.GyroPredictor`.
+
+    ``w_cam = R_cam_imu (w_imu - bias)`` and ``t_imu = t_cam + time_offset_ns``.  Each field is declared with its
+    meaning, unit and range (:func:`~iemd_ros.common.params.param`).
+
+    Raises
+    ------
+    ValueError
+        For a value of the wrong kind or out of its range, an ``R_cam_imu`` that is not a proper rotation, or settings
+        the IMU buffer or the still-bias estimator refuse.
+    """
 
     time_offset_ns: int = param(0, "camera-IMU time offset, t_imu = t_cam + offset (Kalibr's timeshift_cam_imu)",
                                 unit="ns", range=(-1e9, 1e9), decision="gyro-time-offset")
@@ -66,12 +75,34 @@ class GyroConfig:
 
     @classmethod
     def from_dict(cls, values: dict) -> "GyroConfig":
-        """From plain values by field name (missing: defaults); ValueError for unknown names or bad values."""
+        """Configuration from plain values by field name (missing: defaults).
+
+        Parameters
+        ----------
+        values : dict
+            Field name -> value.
+
+        Returns
+        -------
+        GyroConfig
+            The configuration.
+
+        Raises
+        ------
+        ValueError
+            For unknown names or bad values.
+        """
         unknown = set(values) - {f.name for f in fields(cls)}
         if unknown:
             raise ValueError(f"unknown gyro parameters: {', '.join(sorted(unknown))}")
         return cls(**values)
 
     def to_dict(self) -> dict:
-        """Plain values by field name (sequences as lists); round-trips through :meth:`from_dict`."""
+        """Plain values by field name, which round-trip through :meth:`from_dict`.
+
+        Returns
+        -------
+        dict
+            Field name -> value, sequences as lists.
+        """
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}

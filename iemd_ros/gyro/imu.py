@@ -58,9 +58,20 @@ _NO_STAMP = np.iinfo(np.int64).min      # "no stamp yet" for the compiled screen
 class ImuIntegration:
     """Result of integrating the gyro over one frame interval.
 
-    ``R`` is the orientation at ``t1`` expressed in the frame at ``t0`` (identity unless covered);
-    ``n_samples`` counts the buffered samples whose values entered the integral (the bracketing
-    ones included); ``max_gap_ns`` is the largest spacing between them.
+    Parameters
+    ----------
+    R : ndarray
+        3x3 orientation at ``t1`` expressed in the frame at ``t0`` (identity unless covered).
+    n_samples : int
+        Buffered samples whose values entered the integral (the bracketing ones included).
+    status : Coverage
+        How the buffered samples cover the window.
+    reason : str
+        The status in words.
+    t0_ns, t1_ns : int
+        The window, IMU clock, ns.
+    max_gap_ns : int, optional
+        Largest spacing between the samples used.
     """
 
     R: np.ndarray
@@ -78,6 +89,7 @@ class ImuIntegration:
 
     @property
     def ok(self) -> bool:
+        """True when the window is covered without a gap (status ``ok``)."""
         return self.status is Coverage.OK
 
 
@@ -94,11 +106,19 @@ class ImuBuffer:
 
     Parameters
     ----------
-    max_duration_ns : samples older than ``newest - max_duration_ns`` are dropped.
-    max_samples : hard cap on the number of stored samples (oldest dropped first).
-    saturation : per-axis limit in rad/s on the raw rate; ``|w_i| >= saturation`` rejects a sample
-        (``None``: no limit).
-    max_gap_ns : sample spacing above which an integration window is reported as ``gap``.
+    max_duration_ns : int, optional
+        Samples older than ``newest - max_duration_ns`` are dropped.
+    max_samples : int, optional
+        Hard cap on the number of stored samples (oldest dropped first), at least 2.
+    saturation : float or None, optional
+        Per-axis limit in rad/s on the raw rate; ``|w_i| >= saturation`` rejects a sample (``None``: no limit).
+    max_gap_ns : int, optional
+        Sample spacing above which an integration window is reported as ``gap``.
+
+    Raises
+    ------
+    ValueError
+        For invalid settings (:meth:`check_settings`).
     """
 
     def __init__(self, max_duration_ns: int = 10_000_000_000, max_samples: int = 20_000,
@@ -122,7 +142,24 @@ class ImuBuffer:
 
     @staticmethod
     def check_settings(max_duration_ns, max_samples, saturation, max_gap_ns) -> None:
-        """ValueError unless the parameters are valid (see the class docstring)."""
+        """Check the buffer's settings (see the class docstring).
+
+        Parameters
+        ----------
+        max_duration_ns : int
+            As the class takes it.
+        max_samples : int
+            As the class takes it.
+        saturation : float or None
+            As the class takes it.
+        max_gap_ns : int
+            As the class takes it.
+
+        Raises
+        ------
+        ValueError
+            Unless ``max_duration_ns > 0``, ``max_samples >= 2``, ``saturation`` is None or > 0, and ``max_gap_ns > 0``.
+        """
         if int(max_duration_ns) <= 0 or int(max_samples) < 2:
             raise ValueError(f"need max_duration_ns > 0 and max_samples >= 2, got {max_duration_ns}, {max_samples}")
         if saturation is not None and not saturation > 0:
@@ -132,12 +169,27 @@ class ImuBuffer:
 
     # ------------------------------------------------------------------ input
     def add(self, t_ns, w) -> np.ndarray:
-        """Add one sample (``t_ns`` int, ``w`` (3,)) or many (``t_ns`` (N,), ``w`` (N, 3)).
+        """Add one gyro sample or many.
 
-        ``w`` is the raw rate in rad/s in the IMU frame.  Returns the (N,) :class:`SampleStatus` of the
-        samples (NaN/inf and saturated ones are rejected and counted).  One sample and a batch take the
-        same path: the screening and the order counts are one compiled pass (:func:`_screen`), so
-        adding one IMU message costs a few microseconds.
+        NaN/inf and saturated samples are rejected and counted.  One sample and a batch take the same path: the
+        screening and the order counts are one compiled pass (:func:`_screen`).
+
+        Parameters
+        ----------
+        t_ns : int or array_like
+            Stamp, or (N,) stamps, integer ns.
+        w : array_like
+            (3,) or (N, 3) raw rates in rad/s in the IMU frame.
+
+        Returns
+        -------
+        ndarray
+            (N,) :class:`SampleStatus` of the samples.
+
+        Raises
+        ------
+        ValueError
+            For shapes other than (N,) and (N, 3), or stamps that are not integer nanoseconds.
         """
         t = np.array(t_ns, ndmin=1)                          # copies: the caller may reuse its arrays
         w = np.array(w, dtype=float, order="C")
@@ -213,11 +265,35 @@ class ImuBuffer:
         return self._t_max
 
     def covers(self, t_ns: int) -> bool:
-        """True once a sample at or past ``t_ns`` has arrived (a frame at ``t_ns`` can be integrated)."""
+        """True once a sample at or past ``t_ns`` has arrived (a frame at ``t_ns`` can be integrated).
+
+        Parameters
+        ----------
+        t_ns : int
+            IMU clock, ns.
+
+        Returns
+        -------
+        bool
+            Whether the buffer covers ``t_ns``.
+        """
         return self._t_max is not None and self._t_max >= int(t_ns)
 
     def samples(self, t0_ns: int | None = None, t1_ns: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-        """Copies of the stored (merged, sorted) samples with ``t0_ns <= t <= t1_ns``."""
+        """Copies of the stored (merged, sorted) samples with ``t0_ns <= t <= t1_ns``.
+
+        Parameters
+        ----------
+        t0_ns, t1_ns : int, optional
+            The window, IMU clock, ns (None: unbounded on that side).
+
+        Returns
+        -------
+        t : ndarray
+            (M,) int64 stamps.
+        w : ndarray
+            (M, 3) rates, rad/s.
+        """
         with self._lock:
             self._merge()
             lo = 0 if t0_ns is None else int(np.searchsorted(self._t, int(t0_ns), "left"))
@@ -225,7 +301,18 @@ class ImuBuffer:
             return self._t[lo:hi].copy(), self._w[lo:hi].copy()
 
     def gaps(self, t0_ns: int | None = None, t1_ns: int | None = None) -> list[tuple[int, int]]:
-        """Pairs ``(t_before, t_after)`` of consecutive stored samples further apart than ``max_gap_ns``."""
+        """Consecutive stored samples further apart than ``max_gap_ns``.
+
+        Parameters
+        ----------
+        t0_ns, t1_ns : int, optional
+            The window searched, as :meth:`samples` takes it.
+
+        Returns
+        -------
+        list of tuple of int
+            Pairs ``(t_before, t_after)``.
+        """
         t, _ = self.samples(t0_ns, t1_ns)
         i = np.nonzero(np.diff(t) > self.max_gap_ns)[0]
         return [(int(t[j]), int(t[j + 1])) for j in i]
@@ -234,10 +321,29 @@ class ImuBuffer:
                   coning: bool = True) -> ImuIntegration:
         """Integrate the rate over ``[t0_ns, t1_ns]`` (IMU clock) into the rotation of ``t1`` in ``t0``.
 
-        Rates are interpolated linearly at both ends, then integrated exactly by ``_window_rotation``
-        (one compiled pass through :func:`iemd_ros.gyro.rotation.magnus_product`, the core of
-        :func:`iemd_ros.gyro.rotation.integrate_rates`: the same maths).  With a ``calibration`` the bias is
-        removed and the rotation is expressed in the camera frame: ``R_cam = R_cam_imu R R_cam_imu^T``.
+        Rates are interpolated linearly at both ends, then integrated exactly by ``_window_rotation`` (one compiled pass
+        through :func:`iemd_ros.gyro.rotation.magnus_product`, the core of
+        :func:`iemd_ros.gyro.rotation.integrate_rates`: the same maths).
+
+        Parameters
+        ----------
+        t0_ns, t1_ns : int
+            The window, IMU clock, ns.
+        calibration : GyroCalibration, optional
+            With it the bias is removed and the rotation is expressed in the camera frame:
+            ``R_cam = R_cam_imu R R_cam_imu^T``.
+        coning : bool, optional
+            Apply the coning correction.
+
+        Returns
+        -------
+        ImuIntegration
+            The rotation (identity unless covered), the window's coverage status and the reason.
+
+        Raises
+        ------
+        ValueError
+            When the window ends before it starts.
         """
         t0, t1 = int(t0_ns), int(t1_ns)
         if t1 < t0:
@@ -275,7 +381,13 @@ class ImuBuffer:
         return ImuIntegration(R, n_used, Coverage.OK, f"{n_used} gyro samples", t0, t1, max_gap)
 
     def stats(self) -> dict:
-        """Counters (added, accepted, nan, saturated, duplicates, out_of_order, late, dropped) and size."""
+        """The buffer's counters and size.
+
+        Returns
+        -------
+        dict
+            The counts added, accepted, nan, saturated, duplicates, out_of_order, late, dropped, and the size stored.
+        """
         with self._lock:
             self._merge()
             return dict(self.counts, stored=len(self._t))

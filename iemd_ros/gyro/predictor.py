@@ -42,9 +42,26 @@ __all__ = ["rotation_homography", "warp_points", "box_grid", "local_prior", "pre
 
 
 def rotation_homography(K, R, K_inv=None) -> np.ndarray:
-    """``K R^T K^-1``: undistorted pixels of frame k-1 -> frame k, for ``R`` = camera k in camera k-1.
+    """``K R^T K^-1``: undistorted pixels of frame k-1 -> frame k.
 
-    ``K_inv``: ``K^-1`` when the caller has it (``CameraModel.K_inv``), else it is computed.
+    Parameters
+    ----------
+    K : array_like
+        3x3 camera matrix.
+    R : array_like
+        3x3 orientation of camera k in camera k-1.
+    K_inv : array_like, optional
+        ``K^-1`` when the caller has it (``CameraModel.K_inv``), else it is computed.
+
+    Returns
+    -------
+    ndarray
+        3x3 homography scaled to H[2, 2] = 1.
+
+    Raises
+    ------
+    ValueError
+        When K or R is not 3x3.
     """
     K = np.asarray(K, dtype=float)
     R = np.asarray(R, dtype=float)
@@ -55,9 +72,23 @@ def rotation_homography(K, R, K_inv=None) -> np.ndarray:
 
 
 def warp_points(points, H, camera: CameraModel | None = None) -> np.ndarray:
-    """Map raw-image points (..., 2) of frame k-1 to frame k: undistort -> ``H`` -> distort.
+    """Map raw-image points of frame k-1 to frame k: undistort -> ``H`` -> distort.
 
     Points and ``H`` are in OpenCV pixel-centre coordinates; without distortion this is just ``H``.
+
+    Parameters
+    ----------
+    points : array_like
+        (..., 2) raw-image points of frame k-1.
+    H : array_like
+        3x3 homography on undistorted pixels.
+    camera : CameraModel, optional
+        The lens (None: no distortion).
+
+    Returns
+    -------
+    ndarray
+        (..., 2) raw-image points of frame k (NaN where the lens model cannot be inverted).
     """
     p = np.asarray(points, dtype=float)
     H = np.asarray(H, dtype=float)
@@ -67,7 +98,23 @@ def warp_points(points, H, camera: CameraModel | None = None) -> np.ndarray:
 
 
 def box_grid(box) -> np.ndarray:
-    """The 3x3 grid of a box's region: 4 corners (TL, TR, BR, BL), 4 edge midpoints, centre (last)."""
+    """The 3x3 grid of a box's region.
+
+    Parameters
+    ----------
+    box : array_like
+        (x, y, w, h), covering the region ``[x-0.5, x+w-0.5]``.
+
+    Returns
+    -------
+    ndarray
+        (9, 2): the 4 corners (TL, TR, BR, BL), the 4 edge midpoints, the centre (last).
+
+    Raises
+    ------
+    ValueError
+        For a box that is not 4 finite values with a positive size.
+    """
     x, y, w, h = check_box(box)
     x, y = x - 0.5, y - 0.5
     xs, ys = [x, x + w / 2, x + w], [y, y + h / 2, y + h]
@@ -79,8 +126,29 @@ def local_prior(box, H, camera: CameraModel | None = None) -> tuple[np.ndarray, 
     """Best 3x3 prior (raw pixels of frame k-1 -> frame k) at ``box`` for the undistorted-pixel ``H``.
 
     Without distortion the exact global ``H`` is returned.  With distortion: least-squares homography
-    (``cv2.findHomography``, method 0) through the lens-aware images of :func:`box_grid`, then a
-    translation so the box centre maps exactly.  Returns ``(prior, max_residual_px)`` over the grid.
+    (``cv2.findHomography``, method 0) through the lens-aware images of :func:`box_grid`, then a translation so the box
+    centre maps exactly.
+
+    Parameters
+    ----------
+    box : array_like
+        (x, y, w, h) in frame k-1.
+    H : array_like
+        3x3 homography on undistorted pixels (:func:`rotation_homography`).
+    camera : CameraModel, optional
+        The lens (None: no distortion).
+
+    Returns
+    -------
+    prior : ndarray
+        3x3 homography on raw pixels.
+    max_residual_px : float
+        Largest residual of the prior over the grid.
+
+    Raises
+    ------
+    ValueError
+        When the box maps outside the lens model's valid region or no homography fits.
     """
     return _prior_and_box(box, H, camera)[:2]
 
@@ -88,8 +156,27 @@ def local_prior(box, H, camera: CameraModel | None = None) -> tuple[np.ndarray, 
 def predict_box(box, H, camera: CameraModel | None = None) -> np.ndarray:
     """Lens-aware predicted box in frame k of ``box`` (frame k-1).
 
-    The centre is the exact image of the box centre; the width/height are the mean lengths of the
-    mapped top/bottom and left/right edges (so a camera roll moves but does not inflate the box).
+    The centre is the exact image of the box centre; the width/height are the mean lengths of the mapped top/bottom and
+    left/right edges (so a camera roll moves but does not inflate the box).
+
+    Parameters
+    ----------
+    box : array_like
+        (x, y, w, h) in frame k-1.
+    H : array_like
+        3x3 homography on undistorted pixels (:func:`rotation_homography`).
+    camera : CameraModel, optional
+        The lens (None: no distortion).
+
+    Returns
+    -------
+    ndarray
+        (x, y, w, h) in frame k.
+
+    Raises
+    ------
+    ValueError
+        When the box maps outside the lens model's valid region.
     """
     return _box_from_grid(_warp_grid(box, box_grid(box), H, camera))
 
@@ -134,9 +221,28 @@ def _box_from_grid(g) -> np.ndarray:
 def warp_difference(frame_prev, frame_cur, H, valid=None, erode: int = 5) -> float:
     """Mean absolute grey-level difference between ``frame_prev`` warped by ``H`` and ``frame_cur``.
 
-    Frames are grey (or BGR, converted) images in the same (undistorted) pixel space; ``valid`` is
-    an optional boolean mask of defined pixels (e.g. after undistortion), shared by both frames.  Only
-    pixels defined in both (eroded by ``erode`` px against interpolation at the borders) count.
+    Only pixels defined in both count, eroded by ``erode`` px against interpolation at the borders.
+
+    Parameters
+    ----------
+    frame_prev, frame_cur : ndarray
+        Grey (or BGR, converted) images in the same (undistorted) pixel space.
+    H : array_like
+        3x3 homography from ``frame_prev`` to ``frame_cur``.
+    valid : ndarray, optional
+        Boolean mask of defined pixels (e.g. after undistortion), shared by both frames.
+    erode : int, optional
+        Erosion of the mask, px (0: none).
+
+    Returns
+    -------
+    float
+        The mean difference, grey levels.
+
+    Raises
+    ------
+    ValueError
+        When the frames differ in size or the warped frame does not overlap the current one.
     """
     a, b = (cv2.cvtColor(f, cv2.COLOR_BGR2GRAY) if f.ndim == 3 else f for f in map(np.asarray, (frame_prev, frame_cur)))
     if a.shape != b.shape:
@@ -157,11 +263,24 @@ def warp_difference(frame_prev, frame_cur, H, valid=None, erode: int = 5) -> flo
 class GyroPrediction:
     """Prediction for frame k from frame k-1.
 
-    ``R``: camera k in camera k-1; ``H``: ``K R^T K^-1`` (undistorted pixels); ``prior``: the 3x3
-    for ``tracker.update(frame, prior=...)`` (raw pixels; fitted locally at ``box`` when the lens
-    distorts); ``box``: the lens-aware predicted box.  ``R``/``H`` are None when the gyro gives no
-    rotation, ``prior``/``box`` also when no box was given or it lies outside the lens model;
-    ``reason`` says why.
+    Parameters
+    ----------
+    integration : ImuIntegration
+        The gyro integration over the frame interval.
+    R : ndarray or None
+        Camera k in camera k-1; None when the gyro gives no rotation.
+    H : ndarray or None
+        ``K R^T K^-1`` (undistorted pixels); None when the gyro gives no rotation.
+    prior : ndarray or None
+        The 3x3 for ``tracker.update(frame, prior=...)`` (raw pixels; fitted locally at ``box`` when the lens
+        distorts); None when the gyro gives no rotation or the box lies outside the lens model (without a box:
+        the global ``H``, :meth:`GyroPredictor.predict`).
+    box : ndarray or None
+        The lens-aware predicted box; None also when no box was given.
+    reason : str
+        Why there is no prior, else the integration's reason.
+    prior_residual_px : float, optional
+        Largest residual of the locally fitted prior over the box grid.
     """
 
     integration: ImuIntegration
@@ -174,24 +293,34 @@ class GyroPrediction:
 
     @property
     def ok(self) -> bool:
+        """Whether the gyro gave a rotation."""
         return self.R is not None
 
     @property
     def status(self) -> Coverage:
+        """The integration's coverage status."""
         return self.integration.status
 
 
 class GyroPredictor:
     """Owns the :class:`~iemd_ros.gyro.imu.ImuBuffer`, the camera model and the gyro configuration.
 
-    Feed raw IMU-frame rates with :meth:`add_imu`; for consecutive frames call
-    :meth:`predict` with their camera stamps (and the previous box).  If the gyro does not cover the
-    new frame yet, the result has ``status == not_covered`` and no prior: wait a bounded time
-    (:meth:`ready`) and call again, or go on without the prior and log ``reason``.  ``camera`` may be
-    None until the calibration is known (set it then): samples are buffered, :meth:`predict` needs it.
-    ``config`` is checked by :class:`GyroConfig` when it is built, and the parts built from it here
-    (calibration, IMU buffer, bias estimator) check their own values again, so a field changed
-    afterwards is still caught.
+    Feed raw IMU-frame rates with :meth:`add_imu`; for consecutive frames call :meth:`predict` with their camera stamps
+    (and the previous box).  If the gyro does not cover the new frame yet, the result has ``status == not_covered`` and
+    no prior: wait a bounded time (:meth:`ready`) and call again, or go on without the prior and log ``reason``.
+
+    Parameters
+    ----------
+    camera : CameraModel or None
+        May be None until the calibration is known (set it then): samples are buffered, :meth:`predict` needs it.
+    config : GyroConfig, optional
+        Checked by :class:`GyroConfig` when it is built; the parts built from it here (calibration, IMU buffer, bias
+        estimator) check their own values again, so a field changed afterwards is still caught.
+
+    Raises
+    ------
+    ValueError
+        For a ``camera`` that is not a CameraModel or None, or invalid ``config`` values.
     """
 
     def __init__(self, camera: CameraModel | None, config: GyroConfig | None = None):
@@ -209,8 +338,25 @@ class GyroPredictor:
         return self._cal
 
     def add_imu(self, t_ns, w) -> np.ndarray:
-        """Add raw gyro samples (IMU frame, rad/s, stamps in ns on the IMU clock); returns their
-        :class:`~iemd_ros.gyro.imu.SampleStatus` (the accepted ones also feed the still-start bias estimate)."""
+        """Add raw gyro samples; the accepted ones also feed the still-start bias estimate.
+
+        Parameters
+        ----------
+        t_ns : int or array_like
+            Stamp(s) in ns on the IMU clock.
+        w : array_like
+            (3,) or (N, 3) rates, IMU frame, rad/s.
+
+        Returns
+        -------
+        ndarray
+            The samples' :class:`~iemd_ros.gyro.imu.SampleStatus`.
+
+        Raises
+        ------
+        ValueError
+            For bad shapes or stamps (:meth:`~iemd_ros.gyro.imu.ImuBuffer.add`).
+        """
         status = self.buffer.add(t_ns, w)
         if not self.bias_estimator.done:
             good = status == ACCEPTED_STATUS
@@ -219,23 +365,74 @@ class GyroPredictor:
         return status
 
     def imu_time(self, t_cam_ns: int) -> int:
-        """IMU-clock time of a camera stamp (``t_cam + time_offset_ns``)."""
+        """IMU-clock time of a camera stamp (``t_cam + time_offset_ns``).
+
+        Parameters
+        ----------
+        t_cam_ns : int
+            Camera stamp, ns.
+
+        Returns
+        -------
+        int
+            IMU-clock time, ns.
+        """
         return int(t_cam_ns) + int(self.config.time_offset_ns)
 
     def ready(self, t_cam_ns: int) -> bool:
-        """True once the gyro covers the frame stamped ``t_cam_ns``."""
+        """True once the gyro covers the frame stamped ``t_cam_ns``.
+
+        Parameters
+        ----------
+        t_cam_ns : int
+            Camera stamp, ns.
+
+        Returns
+        -------
+        bool
+            Whether the frame can be integrated.
+        """
         return self.buffer.covers(self.imu_time(t_cam_ns))
 
     def rotation(self, t_prev_ns: int, t_cur_ns: int) -> ImuIntegration:
-        """Rotation of camera k (``t_cur_ns``) in camera k-1 (``t_prev_ns``), camera frame."""
+        """Rotation of camera k (``t_cur_ns``) in camera k-1 (``t_prev_ns``), camera frame.
+
+        Parameters
+        ----------
+        t_prev_ns, t_cur_ns : int
+            Camera stamps of frames k-1 and k, ns.
+
+        Returns
+        -------
+        ImuIntegration
+            The rotation with its coverage status.
+        """
         return self.buffer.integrate(self.imu_time(t_prev_ns), self.imu_time(t_cur_ns), self._cal,
                                      coning=self.config.coning)
 
     def predict(self, t_prev_ns: int, t_cur_ns: int, box=None) -> GyroPrediction:
         """Gyro prediction for the frame at ``t_cur_ns`` from the one at ``t_prev_ns``.
 
-        With ``box`` (frame k-1) the prior is fitted locally at the box and the predicted box is
-        returned; without it the prior is the global ``H`` (exact only without lens distortion).
+        With ``box`` (frame k-1) the prior is fitted locally at the box and the predicted box is returned; without it
+        the prior is the global ``H`` (exact only without lens distortion).
+
+        Parameters
+        ----------
+        t_prev_ns, t_cur_ns : int
+            Camera stamps of frames k-1 and k, ns.
+        box : array_like, optional
+            (x, y, w, h) in frame k-1.
+
+        Returns
+        -------
+        GyroPrediction
+            Without a prior when the gyro gives no usable rotation (``reason`` says why) or the box lies outside the
+            lens model.
+
+        Raises
+        ------
+        ValueError
+            Without a camera model.
         """
         if self.camera is None:
             raise ValueError("no camera model: the gyro prior needs K")
@@ -254,8 +451,11 @@ class GyroPredictor:
 
 
 def warm_up() -> None:
-    """Compile the gyro path's numba kernels now (or load them from numba's on-disk cache): the IMU screening,
-    the window integration and the lens model, so that the first IMU message and prediction do not stall."""
+    """Compile the gyro path's numba kernels now (or load them from numba's on-disk cache).
+
+    The IMU screening, the window integration and the lens model, so that the first IMU message and prediction do not
+    stall.
+    """
     predictor = GyroPredictor(CameraModel(np.diag([100.0, 100.0, 1.0]), [0.1, 0.0, 0.0, 0.0, 0.0], 64, 48))
     predictor.add_imu(np.array([0, 10_000_000, 20_000_000]), np.full((3, 3), 0.1))
     predictor.predict(2_000_000, 12_000_000, (16.0, 16.0, 16.0, 16.0))

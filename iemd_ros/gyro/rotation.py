@@ -31,7 +31,18 @@ __all__ = [
 
 
 def skew(w) -> np.ndarray:
-    """``[w]x``: the 3x3 cross-product matrix of ``w`` (also (N,3) -> (N,3,3))."""
+    """``[w]x``: the 3x3 cross-product matrix of ``w``.
+
+    Parameters
+    ----------
+    w : array_like
+        (3,) vector, or (N, 3) vectors.
+
+    Returns
+    -------
+    ndarray
+        (3, 3), or (N, 3, 3).
+    """
     w = np.asarray(w, dtype=float)
     out = np.zeros(w.shape[:-1] + (3, 3))
     out[..., 0, 1], out[..., 0, 2] = -w[..., 2], w[..., 1]
@@ -41,7 +52,18 @@ def skew(w) -> np.ndarray:
 
 
 def quat_mul(p, q) -> np.ndarray:
-    """Hamilton product ``p * q`` of scalar-first quaternions (broadcasts over leading axes)."""
+    """Hamilton product ``p * q`` of scalar-first quaternions.
+
+    Parameters
+    ----------
+    p, q : array_like
+        (..., 4) quaternions; the leading axes broadcast.
+
+    Returns
+    -------
+    ndarray
+        (..., 4) products.
+    """
     p = np.asarray(p, dtype=float)
     q = np.asarray(q, dtype=float)
     pw, px, py, pz = np.moveaxis(p, -1, 0)
@@ -55,7 +77,23 @@ def quat_mul(p, q) -> np.ndarray:
 
 
 def quat_normalize(q) -> np.ndarray:
-    """Unit quaternion with a non-negative scalar part (``q`` and ``-q`` are the same rotation)."""
+    """Unit quaternion with a non-negative scalar part (``q`` and ``-q`` are the same rotation).
+
+    Parameters
+    ----------
+    q : array_like
+        (..., 4) quaternions.
+
+    Returns
+    -------
+    ndarray
+        (..., 4) unit quaternions.
+
+    Raises
+    ------
+    ValueError
+        For a zero or non-finite quaternion.
+    """
     q = np.asarray(q, dtype=float)
     n = np.linalg.norm(q, axis=-1, keepdims=True)
     if (n == 0).any() or not np.isfinite(n).all():
@@ -65,9 +103,24 @@ def quat_normalize(q) -> np.ndarray:
 
 
 def quat_to_rot(q) -> np.ndarray:
-    """Rotation matrix of a unit quaternion ``[m, a, b, c]`` (paper eq. 22), (..., 4) -> (..., 3, 3).
+    """Rotation matrix of a unit quaternion ``[m, a, b, c]`` (paper eq. 22).
 
     The nine entries go into one array (for one quaternion they are numpy scalars: no stacking).
+
+    Parameters
+    ----------
+    q : array_like
+        (..., 4) quaternions (normalized here).
+
+    Returns
+    -------
+    ndarray
+        (..., 3, 3) rotation matrices.
+
+    Raises
+    ------
+    ValueError
+        For a zero or non-finite quaternion.
     """
     q = quat_normalize(q)
     m, a, b, c = q.transpose(-1, *range(q.ndim - 1))
@@ -78,7 +131,23 @@ def quat_to_rot(q) -> np.ndarray:
 
 
 def rot_to_quat(R) -> np.ndarray:
-    """Unit quaternion of a rotation matrix (Shepperd's method, robust for all angles)."""
+    """Unit quaternion of a rotation matrix (Shepperd's method, robust for all angles).
+
+    Parameters
+    ----------
+    R : array_like
+        (..., 3, 3) rotation matrices.
+
+    Returns
+    -------
+    ndarray
+        (..., 4) unit quaternions with a non-negative scalar part.
+
+    Raises
+    ------
+    ValueError
+        When the last two axes are not 3 x 3.
+    """
     R = np.asarray(R, dtype=float)
     if R.shape[-2:] != (3, 3):
         raise ValueError(f"rotation matrices must be (..., 3, 3), got shape {R.shape}")
@@ -96,7 +165,18 @@ def rot_to_quat(R) -> np.ndarray:
 
 
 def quat_exp(phi) -> np.ndarray:
-    """Unit quaternion of the rotation vector ``phi`` (exact exponential map), (..., 3) -> (..., 4)."""
+    """Unit quaternion of the rotation vector ``phi`` (exact exponential map).
+
+    Parameters
+    ----------
+    phi : array_like
+        (..., 3) rotation vectors, radians.
+
+    Returns
+    -------
+    ndarray
+        (..., 4) unit quaternions.
+    """
     phi = np.asarray(phi, dtype=float)
     theta = np.linalg.norm(phi, axis=-1, keepdims=True)
     half = 0.5 * theta
@@ -107,18 +187,51 @@ def quat_exp(phi) -> np.ndarray:
 
 
 def so3_exp(phi) -> np.ndarray:
-    """Rotation matrix ``exp([phi]x)`` (Rodrigues), (..., 3) -> (..., 3, 3)."""
+    """Rotation matrix ``exp([phi]x)`` (Rodrigues).
+
+    Parameters
+    ----------
+    phi : array_like
+        (..., 3) rotation vectors, radians.
+
+    Returns
+    -------
+    ndarray
+        (..., 3, 3) rotation matrices.
+    """
     return quat_to_rot(quat_exp(phi))
 
 
 def rotation_angle(R) -> np.ndarray:
-    """Angle of a rotation matrix in radians (numerically safe for small and large angles)."""
+    """Angle of a rotation matrix (numerically safe for small and large angles).
+
+    Parameters
+    ----------
+    R : array_like
+        (..., 3, 3) rotation matrices.
+
+    Returns
+    -------
+    ndarray
+        (...) angles in radians.
+    """
     q = rot_to_quat(R)
     return 2.0 * np.arctan2(np.linalg.norm(q[..., 1:], axis=-1), np.abs(q[..., 0]))
 
 
 def omega_matrix(w) -> np.ndarray:
-    """The paper's 4x4 ``Omega(w) = [[0, -w^T], [w, -[w]x]]`` (eq. 21), with ``Omega(w) q = q * (0, w)``."""
+    """The paper's 4x4 ``Omega(w) = [[0, -w^T], [w, -[w]x]]`` (eq. 21), with ``Omega(w) q = q * (0, w)``.
+
+    Parameters
+    ----------
+    w : array_like
+        (..., 3) body rates.
+
+    Returns
+    -------
+    ndarray
+        (..., 4, 4) matrices.
+    """
     w = np.asarray(w, dtype=float)
     out = np.zeros(w.shape[:-1] + (4, 4))
     out[..., 0, 1:] = -w
@@ -150,10 +263,28 @@ def _exp_product(phi):
 def integrate_rates(t, w, coning: bool = True) -> np.ndarray:
     """Exact integration of a piecewise-linear body rate through knots ``(t_i, w_i)``.
 
-    Returns the unit quaternion of ``R = prod_i exp(phi_i)`` (right-multiplied, so ``R`` is the
-    orientation at ``t[-1]`` in the frame at ``t[0]``), with
-    ``phi_i = h_i (w_i + w_{i+1}) / 2 + coning * h_i^2 / 12 (w_i x w_{i+1})`` (4th-order Magnus
-    for a linear rate).  ``t`` in seconds (any origin), strictly increasing; ``w`` (N, 3) rad/s.
+    The rotation is ``R = prod_i exp(phi_i)`` (right-multiplied, so ``R`` is the orientation at ``t[-1]`` in the frame
+    at ``t[0]``), with ``phi_i = h_i (w_i + w_{i+1}) / 2 + coning * h_i^2 / 12 (w_i x w_{i+1})`` (4th-order Magnus for
+    a linear rate).
+
+    Parameters
+    ----------
+    t : array_like
+        (N,) knot times in seconds (any origin), strictly increasing.
+    w : array_like
+        (N, 3) rates, rad/s.
+    coning : bool, optional
+        Include the coning term.
+
+    Returns
+    -------
+    ndarray
+        (4,) unit quaternion of ``R`` (the identity with fewer than 2 knots).
+
+    Raises
+    ------
+    ValueError
+        For other shapes, or knot times that do not increase strictly.
     """
     t = np.asarray(t, dtype=float)
     w = np.asarray(w, dtype=float)
@@ -168,7 +299,22 @@ def integrate_rates(t, w, coning: bool = True) -> np.ndarray:
 
 @numba.njit(cache=True)
 def magnus_product(t, w, coning):
-    """The compiled core of :func:`integrate_rates` (knots already checked)."""
+    """The compiled core of :func:`integrate_rates` (knots already checked).
+
+    Parameters
+    ----------
+    t : ndarray
+        (N,) knot times, s, strictly increasing.
+    w : ndarray
+        (N, 3) rates, rad/s.
+    coning : bool
+        Include the coning term.
+
+    Returns
+    -------
+    ndarray
+        (4,) unit quaternion with w >= 0.
+    """
     phi = np.empty((t.size - 1, 3))
     for i in range(t.size - 1):
         h = t[i + 1] - t[i]
@@ -186,8 +332,25 @@ def magnus_product(t, w, coning):
 def integrate_first_order(t, w) -> np.ndarray:
     """The paper's step ``q(k+1) = q(k) + 1/2 Omega(w_k) q(k) dt`` (eq. 21), renormalized each step.
 
-    Forward Euler with the rate held at each sample over ``[t_k, t_{k+1})`` (as a sampled gyro is
-    used in the paper's Algorithm 2).  Returns the final unit quaternion.
+    Forward Euler with the rate held at each sample over ``[t_k, t_{k+1})`` (as a sampled gyro is used in the paper's
+    Algorithm 2).
+
+    Parameters
+    ----------
+    t : array_like
+        (N,) sample times, s.
+    w : array_like
+        (N, 3) rates, rad/s.
+
+    Returns
+    -------
+    ndarray
+        (4,) the final unit quaternion.
+
+    Raises
+    ------
+    ValueError
+        For other shapes.
     """
     t = np.asarray(t, dtype=float)
     w = np.asarray(w, dtype=float)
@@ -201,7 +364,20 @@ def integrate_first_order(t, w) -> np.ndarray:
 
 @dataclass(frozen=True)
 class GyroCalibration:
-    """IMU->camera rotation and gyro bias: ``w_cam = R_cam_imu (w_imu - bias)``."""
+    """IMU->camera rotation and gyro bias: ``w_cam = R_cam_imu (w_imu - bias)``.
+
+    Parameters
+    ----------
+    R_cam_imu : array_like, optional
+        3x3 proper rotation (None: identity).
+    bias : array_like, optional
+        (3,) gyro bias in the IMU frame, rad/s (None: zeros).
+
+    Raises
+    ------
+    ValueError
+        For a rotation that is not proper or a bias that is not 3 finite values.
+    """
 
     R_cam_imu: np.ndarray = None  # type: ignore[assignment]
     bias: np.ndarray = None  # type: ignore[assignment]
@@ -213,8 +389,27 @@ class GyroCalibration:
 
     @staticmethod
     def checked(R_cam_imu, bias) -> tuple[np.ndarray, np.ndarray]:
-        """``(R_cam_imu, bias)`` as arrays (None: identity, zeros); ValueError unless a proper
-        rotation and 3 finite values."""
+        """``(R_cam_imu, bias)`` as arrays, checked.
+
+        Parameters
+        ----------
+        R_cam_imu : array_like or None
+            3x3 rotation (None: identity).
+        bias : array_like or None
+            3 values, rad/s (None: zeros).
+
+        Returns
+        -------
+        R_cam_imu : ndarray
+            (3, 3) rotation.
+        bias : ndarray
+            (3,) bias.
+
+        Raises
+        ------
+        ValueError
+            Unless a proper rotation and 3 finite values.
+        """
         R = np.eye(3) if R_cam_imu is None else np.asarray(R_cam_imu, dtype=float)
         b = np.zeros(3) if bias is None else np.asarray(bias, dtype=float)
         if R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6) or np.linalg.det(R) < 0:
@@ -224,15 +419,38 @@ class GyroCalibration:
         return R, b
 
     def to_camera(self, w_imu) -> np.ndarray:
-        """Camera-frame rates of (N, 3) IMU-frame rates."""
+        """Camera-frame rates of IMU-frame rates.
+
+        Parameters
+        ----------
+        w_imu : array_like
+            (N, 3) IMU-frame rates, rad/s.
+
+        Returns
+        -------
+        ndarray
+            (N, 3) camera-frame rates, the bias removed.
+        """
         return (np.asarray(w_imu, dtype=float) - self.bias) @ self.R_cam_imu.T
 
 
 class StillBiasEstimator:
     """Gyro bias from a still start: the mean of the first ``n`` samples if their spread is small.
 
-    The spread is the largest per-axis standard deviation; above ``max_std`` (rad/s) the start is
-    not still and no estimate is made (``status`` says why).  ``n == 0`` disables it.
+    The spread is the largest per-axis standard deviation; above ``max_std`` the start is not still and no estimate is
+    made (``status`` says why).
+
+    Parameters
+    ----------
+    n : int, optional
+        Number of samples; ``n == 0`` disables the estimate, else at least 2.
+    max_std : float, optional
+        Largest spread of a still start, rad/s, > 0.
+
+    Raises
+    ------
+    ValueError
+        For other values (:meth:`check_settings`).
     """
 
     def __init__(self, n: int = 0, max_std: float = 0.02):
@@ -245,14 +463,38 @@ class StillBiasEstimator:
 
     @staticmethod
     def check_settings(n, max_std) -> None:
-        """ValueError unless ``n`` is 0 (off) or >= 2 and ``max_std > 0``."""
+        """Check the estimator's settings.
+
+        Parameters
+        ----------
+        n : int
+            Number of samples.
+        max_std : float
+            Largest spread, rad/s.
+
+        Raises
+        ------
+        ValueError
+            Unless ``n`` is 0 (off) or >= 2 and ``max_std > 0``.
+        """
         if n < 0 or (n == 1):
             raise ValueError(f"still-bias sample count must be 0 (off) or >= 2, got {n}")
         if not max_std > 0:
             raise ValueError(f"still-bias max_std must be > 0 rad/s, got {max_std}")
 
     def update(self, w) -> bool:
-        """Feed (3,) or (N, 3) finite IMU-frame rates; returns True once an estimate exists."""
+        """Feed finite IMU-frame rates.
+
+        Parameters
+        ----------
+        w : array_like
+            (3,) or (N, 3) rates, rad/s.
+
+        Returns
+        -------
+        bool
+            True once an estimate exists.
+        """
         if self.done:
             return self.bias is not None
         self._buf.append(np.atleast_2d(np.asarray(w, dtype=float)))

@@ -50,15 +50,37 @@ def _as_bytes(data) -> memoryview:
 
 
 def image_to_array(encoding: str, height: int, width: int, step: int, data, is_bigendian: bool = False) -> np.ndarray:
-    """``sensor_msgs/Image`` fields -> tracker frame (``HxW`` uint8 or ``HxWx3`` uint8 BGR).
+    """``sensor_msgs/Image`` fields -> tracker frame.
 
-    mono8/bgr8 are returned as views of ``data`` when the rows are unpadded; rgb8/bgra8/rgba8 are
-    converted to BGR (alpha dropped).  mono16 (either byte order) is reduced to 8 bits by the right
-    shift that puts the frame's highest set bit at bit 7 (a 12-bit sensor in mono16 keeps its 8 most
-    significant *used* bits instead of turning almost black under a fixed ``>> 8``; the shift only
-    changes when the frame maximum crosses a power of two, and the tracker normalizes the grey
-    levels of its window anyway).  Raises ValueError on an unknown encoding, a ``step`` shorter than
-    a row or a ``data`` size other than ``step * height``.
+    mono8/bgr8 are returned as views of ``data`` when the rows are unpadded; rgb8/bgra8/rgba8 are converted to BGR
+    (alpha dropped).  mono16 (either byte order) is reduced to 8 bits by the right shift that puts the frame's highest
+    set bit at bit 7 (a 12-bit sensor in mono16 keeps its 8 most significant *used* bits instead of turning almost black
+    under a fixed ``>> 8``; the shift only changes when the frame maximum crosses a power of two, and the tracker
+    normalizes the grey levels of its window anyway).
+
+    Parameters
+    ----------
+    encoding : str
+        One of :data:`ENCODINGS`.
+    height, width : int
+        Image size, px.
+    step : int
+        Bytes per row.
+    data : bytes-like
+        The pixels (bytes, bytearray, array.array, numpy array or list of ints), ``step * height`` bytes.
+    is_bigendian : bool, optional
+        Byte order of mono16 pixels.
+
+    Returns
+    -------
+    ndarray
+        ``HxW`` uint8 or ``HxWx3`` uint8 BGR.
+
+    Raises
+    ------
+    ValueError
+        For an unknown encoding, an empty image, a ``step`` shorter than a row or a ``data`` size other than
+        ``step * height``.
     """
     if encoding not in ENCODINGS:
         raise ValueError(f"unsupported image encoding {encoding!r}: expected one of {', '.join(ENCODINGS)}")
@@ -92,14 +114,29 @@ def _to_8bit(pixels: np.ndarray) -> np.ndarray:
 
 
 def compressed_to_array(fmt: str, data) -> np.ndarray:
-    """``sensor_msgs/CompressedImage`` fields -> tracker frame (``HxW`` or ``HxWx3`` uint8 BGR).
+    """``sensor_msgs/CompressedImage`` fields -> tracker frame.
 
-    ``fmt`` is as image_transport's compressed plugin writes it (``"jpeg"``, ``"png"`` or e.g.
-    ``"rgb8; jpeg compressed bgr8"``); the data are decoded by what they are (``cv2.imdecode``), which
-    gives BGR whatever the source encoding (the plugin stores colour as bgr8, and the codec's own
-    channel order is undone by OpenCV).  An alpha channel is dropped; 16-bit PNG (mono16/bgr16) is
-    reduced to 8 bits as mono16 in :func:`image_to_array`.  Raises ValueError for data that do not
-    decode, and for ``compressedDepth`` (depth maps, not camera images).
+    The data are decoded by what they are (``cv2.imdecode``), which gives BGR whatever the source encoding (the plugin
+    stores colour as bgr8, and the codec's own channel order is undone by OpenCV).  An alpha channel is dropped; 16-bit
+    PNG (mono16/bgr16) is reduced to 8 bits as mono16 in :func:`image_to_array`.
+
+    Parameters
+    ----------
+    fmt : str
+        ``format`` as image_transport's compressed plugin writes it (``"jpeg"``, ``"png"`` or e.g.
+        ``"rgb8; jpeg compressed bgr8"``).
+    data : bytes-like
+        The compressed image.
+
+    Returns
+    -------
+    ndarray
+        ``HxW`` or ``HxWx3`` uint8 BGR.
+
+    Raises
+    ------
+    ValueError
+        For data that do not decode, and for ``compressedDepth`` (depth maps, not camera images).
     """
     if "compresseddepth" in str(fmt).lower():
         raise ValueError(f"compressed image format {fmt!r} is a depth map (compressedDepth), not a camera image")
@@ -125,8 +162,24 @@ def compressed_to_array(fmt: str, data) -> np.ndarray:
 def array_to_image_fields(frame: np.ndarray, encoding: str | None = None) -> dict:
     """Tracker frame -> ``sensor_msgs/Image`` fields (``data`` as ``bytes``, the fast path for rclpy).
 
-    ``encoding`` defaults to mono8 for ``HxW`` and bgr8 for ``HxWx3`` uint8 frames; rgb8 flips the
-    channels.  :func:`fill_image_msg` sets them on a message.
+    :func:`fill_image_msg` sets them on a message.
+
+    Parameters
+    ----------
+    frame : ndarray
+        Tracker frame, ``HxW`` or ``HxWx3`` uint8.
+    encoding : str, optional
+        Default mono8 for ``HxW`` and bgr8 for ``HxWx3`` frames; rgb8 flips the channels.
+
+    Returns
+    -------
+    dict
+        The fields encoding, height, width, step, is_bigendian and data.
+
+    Raises
+    ------
+    ValueError
+        For a frame that is not a tracker frame, or an encoding it cannot be written as.
     """
     frame = _check_frame(frame)
     default = "mono8" if frame.ndim == 2 else "bgr8"
@@ -150,7 +203,20 @@ def _check_frame(frame) -> np.ndarray:
 
 
 def check_compression(codec: str, quality: int = JPEG_QUALITY) -> None:
-    """ValueError unless ``codec`` is one of :data:`COMPRESSED_CODECS` and ``quality`` a JPEG quality 1-100."""
+    """Check a compressed image's codec and quality.
+
+    Parameters
+    ----------
+    codec : str
+        One of :data:`COMPRESSED_CODECS`.
+    quality : int, optional
+        JPEG quality, 1-100.
+
+    Raises
+    ------
+    ValueError
+        Unless ``codec`` is one of :data:`COMPRESSED_CODECS` and ``quality`` a JPEG quality 1-100.
+    """
     if codec not in COMPRESSED_CODECS:
         raise ValueError(f"codec must be {' or '.join(map(repr, COMPRESSED_CODECS))}, got {codec!r}")
     if not 1 <= int(quality) <= 100:
@@ -158,27 +224,79 @@ def check_compression(codec: str, quality: int = JPEG_QUALITY) -> None:
 
 
 def compressed_topic(image_topic: str) -> str:
-    """image_transport's name of an image topic's compressed stream: ``<image_topic>/compressed``."""
+    """image_transport's name of an image topic's compressed stream: ``<image_topic>/compressed``.
+
+    Parameters
+    ----------
+    image_topic : str
+        The raw image topic.
+
+    Returns
+    -------
+    str
+        The compressed topic.
+    """
     return image_topic.rstrip("/") + "/compressed"
 
 
 def is_compressed_topic(topic: str) -> bool:
-    """True for a name whose last part is ``compressed`` (image_transport's compressed stream)."""
+    """True for a name whose last part is ``compressed`` (image_transport's compressed stream).
+
+    Parameters
+    ----------
+    topic : str
+        A topic name.
+
+    Returns
+    -------
+    bool
+        Whether it names a compressed stream.
+    """
     return topic.rstrip("/").rpartition("/")[2] == "compressed"
 
 
 def raw_twin(topic: str) -> str | None:
-    """The image topic whose compressed stream ``topic`` is named as (inverse of :func:`compressed_topic`);
-    None for a name that is not ``<image>/compressed``."""
+    """The image topic whose compressed stream ``topic`` is named as (inverse of :func:`compressed_topic`).
+
+    Parameters
+    ----------
+    topic : str
+        A topic name.
+
+    Returns
+    -------
+    str or None
+        The raw image topic; None for a name that is not ``<image>/compressed``.
+    """
     head = topic.rstrip("/").rpartition("/")[0]
     return head if is_compressed_topic(topic) and head else None
 
 
 def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: int = JPEG_QUALITY) -> dict:
-    """Tracker frame -> ``sensor_msgs/CompressedImage`` fields as image_transport's compressed plugin
-    writes them: ``format`` ``"bgr8; jpeg compressed bgr8"``, for ``HxW`` ``"mono8; jpeg compressed "``
-    (the plugin names a target encoding for colour only; ``png`` is lossless) and the encoded ``data``
-    as ``bytes``.  ``quality``: JPEG quality, 1-100."""
+    """Tracker frame -> ``sensor_msgs/CompressedImage`` fields as image_transport's compressed plugin writes them.
+
+    ``format`` is ``"bgr8; jpeg compressed bgr8"``, for ``HxW`` ``"mono8; jpeg compressed "`` (the plugin names a target
+    encoding for colour only; ``png`` is lossless).
+
+    Parameters
+    ----------
+    frame : ndarray
+        Tracker frame, ``HxW`` or ``HxWx3`` uint8.
+    codec : {"jpeg", "png"}, optional
+        The codec.
+    quality : int, optional
+        JPEG quality, 1-100.
+
+    Returns
+    -------
+    dict
+        ``format`` and the encoded ``data`` as ``bytes``.
+
+    Raises
+    ------
+    ValueError
+        For a bad frame, codec or quality, or a frame OpenCV cannot encode.
+    """
     frame = _check_frame(frame)
     check_compression(codec, quality)
     params = [cv2.IMWRITE_JPEG_QUALITY, int(quality)] if codec == "jpeg" else []
@@ -190,9 +308,30 @@ def array_to_compressed_fields(frame: np.ndarray, codec: str = "jpeg", quality: 
 
 
 def fill_image_msg(msg, frame: np.ndarray, encoding: str | None = None):
-    """Set a ``sensor_msgs/Image``'s pixel fields from a tracker frame (:func:`array_to_image_fields`);
-    returns ``msg``.  The header is the caller's.  ``data`` goes in as ``bytes``, which an rclpy message copies
-    at once, where a numpy array is converted element by element."""
+    """Set a ``sensor_msgs/Image``'s pixel fields from a tracker frame (:func:`array_to_image_fields`).
+
+    The header is the caller's.  ``data`` goes in as ``bytes``, which an rclpy message copies at once, where a numpy
+    array is converted element by element.
+
+    Parameters
+    ----------
+    msg : sensor_msgs/Image
+        The message to fill.
+    frame : ndarray
+        Tracker frame, ``HxW`` or ``HxWx3`` uint8.
+    encoding : str, optional
+        As :func:`array_to_image_fields` takes it.
+
+    Returns
+    -------
+    sensor_msgs/Image
+        ``msg``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`array_to_image_fields` raises it.
+    """
     for name, value in array_to_image_fields(frame, encoding).items():
         setattr(msg, name, value)
     return msg
@@ -201,8 +340,22 @@ def fill_image_msg(msg, frame: np.ndarray, encoding: str | None = None):
 def camera_model_from_msg(msg) -> CameraModel:
     """The camera model of a ``sensor_msgs/CameraInfo`` (ROS 2 ``k``/``d`` or ROS 1 ``K``/``D`` fields).
 
-    A driver repeats the same CameraInfo with every image; each content is turned into a model once.  Bad content
-    raises ValueError (not cached).
+    A driver repeats the same CameraInfo with every image; each content is turned into a model once.
+
+    Parameters
+    ----------
+    msg : sensor_msgs/CameraInfo
+        An rclpy or rosbags message.
+
+    Returns
+    -------
+    CameraModel
+        The model (:func:`camera_model_from_info`).
+
+    Raises
+    ------
+    ValueError
+        For bad content (not cached).
     """
     k = getattr(msg, "k", None)
     d = getattr(msg, "d", None)
@@ -219,8 +372,27 @@ def _camera_model(k: tuple, d: tuple, distortion_model: str, width: int, height:
 def camera_model_from_info(k, d, distortion_model: str, width: int, height: int) -> CameraModel:
     """``sensor_msgs/CameraInfo`` fields -> :class:`~iemd_ros.gyro.camera.CameraModel` (K and plumb_bob D).
 
-    An all-zero ``k`` (an uncalibrated driver) and non-plumb_bob models with non-zero coefficients
-    raise ValueError saying so.
+    Parameters
+    ----------
+    k : sequence of float
+        The 9 values of K.
+    d : sequence of float
+        The distortion coefficients.
+    distortion_model : str
+        The distortion model ("" means plumb_bob).
+    width, height : int
+        Image size (0: unknown).
+
+    Returns
+    -------
+    CameraModel
+        The model.
+
+    Raises
+    ------
+    ValueError
+        For a ``k`` not of 9 values, an all-zero ``k`` (an uncalibrated driver) and non-plumb_bob models with non-zero
+        coefficients, saying so.
     """
     K = np.asarray(k, dtype=float).ravel()
     if K.shape != (9,):
@@ -234,32 +406,96 @@ def camera_model_from_info(k, d, distortion_model: str, width: int, height: int)
 
 
 def stamp_to_ns(sec: int, nanosec: int) -> int:
-    """``builtin_interfaces/Time`` -> integer nanoseconds."""
+    """``builtin_interfaces/Time`` -> integer nanoseconds.
+
+    Parameters
+    ----------
+    sec, nanosec : int
+        The stamp's fields.
+
+    Returns
+    -------
+    int
+        Nanoseconds.
+    """
     return int(sec) * 1_000_000_000 + int(nanosec)
 
 
 def image_from_msg(msg) -> np.ndarray:
-    """A ``sensor_msgs/Image`` (:func:`image_to_array`) or ``sensor_msgs/CompressedImage``
-    (:func:`compressed_to_array`), rclpy or rosbags message -> tracker frame."""
+    """A ``sensor_msgs/Image`` or ``sensor_msgs/CompressedImage`` -> tracker frame.
+
+    Parameters
+    ----------
+    msg : sensor_msgs/Image or sensor_msgs/CompressedImage
+        An rclpy or rosbags message (:func:`image_to_array`, :func:`compressed_to_array`).
+
+    Returns
+    -------
+    ndarray
+        ``HxW`` uint8 or ``HxWx3`` uint8 BGR.
+
+    Raises
+    ------
+    ValueError
+        For an image that cannot be converted.
+    """
     if hasattr(msg, "format"):  # CompressedImage: header, format, data
         return compressed_to_array(msg.format, msg.data)
     return image_to_array(msg.encoding, msg.height, msg.width, msg.step, msg.data, bool(msg.is_bigendian))
 
 
 def imu_sample(msg) -> tuple[int, tuple[float, float, float], float]:
-    """A ``sensor_msgs/Imu`` (rclpy or rosbags message) -> (stamp ns, gyro rates (x, y, z) rad/s,
-    ``angular_velocity_covariance[0]``): the arguments of ``TrackingPipeline.add_imu_message``."""
+    """A ``sensor_msgs/Imu`` -> the arguments of ``TrackingPipeline.add_imu_message``.
+
+    Parameters
+    ----------
+    msg : sensor_msgs/Imu
+        An rclpy or rosbags message.
+
+    Returns
+    -------
+    stamp_ns : int
+        The header's stamp, ns.
+    rates : tuple of float
+        Gyro rates (x, y, z), rad/s.
+    covariance0 : float
+        ``angular_velocity_covariance[0]``.
+    """
     w = msg.angular_velocity
     return stamp_ns(msg.header), (w.x, w.y, w.z), msg.angular_velocity_covariance[0]
 
 
 def stamp_ns(header) -> int:
-    """Nanoseconds of a ``std_msgs/Header`` (rclpy or rosbags message, ROS 1 or 2)."""
+    """Nanoseconds of a ``std_msgs/Header``.
+
+    Parameters
+    ----------
+    header : std_msgs/Header
+        An rclpy or rosbags message, ROS 1 or 2.
+
+    Returns
+    -------
+    int
+        The stamp, ns.
+    """
     return stamp_to_ns(header.stamp.sec, header.stamp.nanosec)
 
 
 def ns_to_stamp(t_ns: int) -> tuple[int, int]:
-    """Integer nanoseconds -> ``(sec, nanosec)`` with ``0 <= nanosec < 1e9``."""
+    """Integer nanoseconds -> ``(sec, nanosec)``.
+
+    Parameters
+    ----------
+    t_ns : int
+        Nanoseconds.
+
+    Returns
+    -------
+    sec : int
+        Seconds.
+    nanosec : int
+        Nanoseconds, ``0 <= nanosec < 1e9``.
+    """
     sec, nsec = divmod(int(t_ns), 1_000_000_000)
     return sec, nsec
 
@@ -267,8 +503,23 @@ def ns_to_stamp(t_ns: int) -> tuple[int, int]:
 def box_to_bbox(box) -> tuple[float, float, float, float]:
     """Tracker box ``(x, y, w, h)`` -> ``vision_msgs/BoundingBox2D`` ``(center_x, center_y, size_x, size_y)``.
 
-    The centre is in pixel-index coordinates (pixel centres at integers, as ``K``):
-    ``x + (w - 1) / 2`` (:func:`iemd_ros.common.boxes.box_centre`); the size is ``w, h`` pixels.
+    The centre is in pixel-index coordinates (pixel centres at integers, as ``K``): ``x + (w - 1) / 2``
+    (:func:`iemd_ros.common.boxes.box_centre`); the size is ``w, h`` pixels.
+
+    Parameters
+    ----------
+    box : sequence of 4 float
+        (x, y, w, h).
+
+    Returns
+    -------
+    tuple of float
+        ``(center_x, center_y, size_x, size_y)``.
+
+    Raises
+    ------
+    ValueError
+        For a box that is not finite with a positive size.
     """
     b = check_box(box)
     cx, cy = box_centre(b)
@@ -276,24 +527,59 @@ def box_to_bbox(box) -> tuple[float, float, float, float]:
 
 
 def bbox_to_box(center_x: float, center_y: float, size_x: float, size_y: float) -> tuple[float, float, float, float]:
-    """Inverse of :func:`box_to_bbox`; raises ValueError for non-finite values or a non-positive size.
+    """Inverse of :func:`box_to_bbox`.
 
-    The values are checked as given (``check_box``'s last two are the sizes), so the
-    message shows what the sender wrote, not the corner box derived from it.
+    The values are checked as given (``check_box``'s last two are the sizes), so the message shows what the sender
+    wrote, not the corner box derived from it.
+
+    Parameters
+    ----------
+    center_x, center_y : float
+        The centre, pixel-index coordinates.
+    size_x, size_y : float
+        The size, px.
+
+    Returns
+    -------
+    tuple of float
+        The tracker box ``(x, y, w, h)``.
+
+    Raises
+    ------
+    ValueError
+        For non-finite values or a non-positive size.
     """
     cx, cy, sx, sy = check_box((center_x, center_y, size_x, size_y), "bounding box (center_x, center_y, size_x, size_y)")
     return tuple(float(v) for v in centre_box((cx, cy), (sx, sy)))
 
 
 def bbox_values(bbox) -> tuple[float, float, float, float]:
-    """A ``vision_msgs/BoundingBox2D`` (rclpy or rosbags message) -> ``(center_x, center_y, size_x, size_y)``."""
+    """A ``vision_msgs/BoundingBox2D`` -> ``(center_x, center_y, size_x, size_y)``.
+
+    Parameters
+    ----------
+    bbox : vision_msgs/BoundingBox2D
+        An rclpy or rosbags message.
+
+    Returns
+    -------
+    tuple of float
+        ``(center_x, center_y, size_x, size_y)``.
+    """
     c = bbox.center.position
     return c.x, c.y, bbox.size_x, bbox.size_y
 
 
 def fill_bbox(bbox, values) -> None:
-    """Set a ``vision_msgs/BoundingBox2D``'s centre and size from ``(center_x, center_y, size_x, size_y)``
-    (:func:`box_to_bbox`'s values); ``theta`` is left as it is."""
+    """Set a ``vision_msgs/BoundingBox2D``'s centre and size; ``theta`` is left as it is.
+
+    Parameters
+    ----------
+    bbox : vision_msgs/BoundingBox2D
+        The message to fill.
+    values : sequence of 4 float
+        ``(center_x, center_y, size_x, size_y)`` (:func:`box_to_bbox`'s values).
+    """
     c = bbox.center.position
     c.x, c.y, bbox.size_x, bbox.size_y = (float(v) for v in values)
 
@@ -303,16 +589,34 @@ DETECTION_ID = "iemd"  # default id of the published Detection2D (node parameter
 
 
 class DetectionValues(NamedTuple):
-    """Values of the tracker's ``vision_msgs/Detection2D``: ``bbox`` ``(center_x, center_y, size_x, size_y)``
-    (``theta`` 0) and its one hypothesis' ``score``."""
+    """Values of the tracker's ``vision_msgs/Detection2D``.
+
+    Parameters
+    ----------
+    bbox : tuple of float
+        ``(center_x, center_y, size_x, size_y)`` (``theta`` 0).
+    score : float
+        Its one hypothesis' score.
+    """
 
     bbox: tuple[float, float, float, float]
     score: float
 
 
 def detection_values(result) -> DetectionValues | None:
-    """A :class:`~iemd_ros.pipeline.pipeline.FrameResult` -> its detection's values (:func:`box_to_bbox` of its box,
-    its score); None when ``result`` is None or not tracking: no detection is published then."""
+    """A :class:`~iemd_ros.pipeline.pipeline.FrameResult` -> its detection's values.
+
+    Parameters
+    ----------
+    result : FrameResult or None
+        The frame's result.
+
+    Returns
+    -------
+    DetectionValues or None
+        :func:`box_to_bbox` of its box and its score; None when ``result`` is None or not tracking: no detection is
+        published then.
+    """
     if result is None or not result.tracking:
         return None
     return DetectionValues(box_to_bbox(result.box), float(result.score))

@@ -20,19 +20,63 @@ class MessageFactory(Protocol):
     def __call__(self, msgtype: str, **fields): ...
 
     def byte(self, value: int):
-        """The value of a ``byte`` field (rclpy: ``bytes`` of length 1; rosbags: an int)."""
+        """The value of a ``byte`` field.
+
+        Parameters
+        ----------
+        value : int
+            The byte's value.
+
+        Returns
+        -------
+        bytes or int
+            For rclpy ``bytes`` of length 1, for rosbags an int.
+        """
 
 
 def header(make: MessageFactory, stamp_ns: int, frame_id: str):
-    """``std_msgs/Header`` stamped ``stamp_ns``."""
+    """``std_msgs/Header`` stamped ``stamp_ns``.
+
+    Parameters
+    ----------
+    make : MessageFactory
+        Builds the messages.
+    stamp_ns : int
+        The stamp, ns.
+    frame_id : str
+        The header's frame.
+
+    Returns
+    -------
+    std_msgs/Header
+        A message of ``make``'s library.
+    """
     sec, nanosec = ns_to_stamp(stamp_ns)
     return make("std_msgs/msg/Header", stamp=make("builtin_interfaces/msg/Time", sec=sec, nanosec=nanosec),
                 frame_id=frame_id)
 
 
 def detection_array(make: MessageFactory, hdr, result, class_id: str, detection_id: str):
-    """The ``vision_msgs/Detection2DArray`` of one frame (header ``hdr``): one detection while ``result`` (a
-    :class:`~iemd_ros.pipeline.FrameResult`, or None) is tracking, else none."""
+    """The ``vision_msgs/Detection2DArray`` of one frame.
+
+    Parameters
+    ----------
+    make : MessageFactory
+        Builds the messages.
+    hdr : std_msgs/Header
+        The header of the array and of its detection.
+    result : FrameResult or None
+        The frame's result (:class:`~iemd_ros.pipeline.FrameResult`).
+    class_id : str
+        The hypothesis' class.
+    detection_id : str
+        The detection's id.
+
+    Returns
+    -------
+    vision_msgs/Detection2DArray
+        One detection while ``result`` is tracking, else none.
+    """
     detections = []
     values = detection_values(result)
     if values is not None:
@@ -51,7 +95,24 @@ def detection_array(make: MessageFactory, hdr, result, class_id: str, detection_
 
 
 def diagnostic_array(make: MessageFactory, hdr, statuses, hardware_id: str):
-    """``diagnostic_msgs/DiagnosticArray`` of ``statuses``: (name, level, message, values) tuples."""
+    """``diagnostic_msgs/DiagnosticArray`` of ``statuses``.
+
+    Parameters
+    ----------
+    make : MessageFactory
+        Builds the messages.
+    hdr : std_msgs/Header
+        The array's header.
+    statuses : iterable of tuple
+        (name, level, message, values) tuples.
+    hardware_id : str
+        The statuses' hardware_id.
+
+    Returns
+    -------
+    diagnostic_msgs/DiagnosticArray
+        One status per tuple.
+    """
     return make(DIAGNOSTICS_TYPE, header=hdr, status=[
         make("diagnostic_msgs/msg/DiagnosticStatus", level=make.byte(int(level)), name=name, message=message,
              hardware_id=hardware_id,

@@ -15,7 +15,16 @@ GROUPS = {"tracker": TrackerConfig, "gyro": GyroConfig}  # parameter groups: tra
 
 @dataclass
 class PipelineConfig:
-    """Tracker + gyro settings and the pipeline's own (``PipelineConfig(tracker=TrackerConfig(...))``)."""
+    """Tracker + gyro settings and the pipeline's own (``PipelineConfig(tracker=TrackerConfig(...))``).
+
+    ``tracker`` and ``gyro`` are the groups ``tracker.<name>`` and ``gyro.<name>``; every field is declared with its
+    meaning, unit and range (:func:`~iemd_ros.common.params.param`).
+
+    Raises
+    ------
+    ValueError
+        When ``tracker`` or ``gyro`` is not of its class, or for an invalid value.
+    """
 
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     gyro: GyroConfig = field(default_factory=GyroConfig)
@@ -34,7 +43,23 @@ class PipelineConfig:
 
     @classmethod
     def from_dict(cls, values: dict) -> "PipelineConfig":
-        """From ``{"tracker": {...}, "gyro": {...}, "use_gyro": ..., ...}`` (missing keys: defaults)."""
+        """Configuration from ``{"tracker": {...}, "gyro": {...}, "use_gyro": ..., ...}`` (missing keys: defaults).
+
+        Parameters
+        ----------
+        values : dict
+            The parameters by name, the groups as mappings.
+
+        Returns
+        -------
+        PipelineConfig
+            The configuration.
+
+        Raises
+        ------
+        ValueError
+            For unknown names, a group that is not a mapping, or invalid values.
+        """
         v = dict(values)
         unknown = set(v) - {f.name for f in fields(cls)}
         if unknown:
@@ -51,8 +76,25 @@ class PipelineConfig:
 
     @classmethod
     def from_parameters(cls, params: dict) -> "PipelineConfig":
-        """From parameters by their dotted names (``tracker.n_iter``, ``use_gyro``); names of no pipeline
-        parameter (the node's own: ``initial_box``, ...) are ignored."""
+        """Configuration from parameters by their dotted names (``tracker.n_iter``, ``use_gyro``).
+
+        Names of no pipeline parameter (the node's own: ``initial_box``, ...) are ignored.
+
+        Parameters
+        ----------
+        params : dict
+            Dotted name -> value.
+
+        Returns
+        -------
+        PipelineConfig
+            The configuration.
+
+        Raises
+        ------
+        ValueError
+            For a group given a single value, a single parameter given as a group, or invalid values.
+        """
         own = {f.name for f in fields(cls)} - set(GROUPS)
         values: dict = {name: {} for name in GROUPS}
         for key, value in params.items():
@@ -69,10 +111,29 @@ class PipelineConfig:
 
     @classmethod
     def from_yaml(cls, path, node_name: str = NODE_NAME) -> "PipelineConfig":
-        """From a YAML file: a ROS parameter file (``config/tracker.yaml``) read as the node ``node_name`` reads it
+        """Configuration from a YAML file.
+
+        A ROS parameter file (``config/tracker.yaml``) read as the node ``node_name`` reads it
         (:func:`~iemd_ros.pipeline.parameter_file.read_parameter_file`), or a plain
-        ``{tracker: {...}, gyro: {...}, use_gyro: ...}`` mapping (:meth:`from_dict`).  ValueError naming the file
-        for a file that cannot be read or holds invalid values."""
+        ``{tracker: {...}, gyro: {...}, use_gyro: ...}`` mapping (:meth:`from_dict`).
+
+        Parameters
+        ----------
+        path : str or path-like
+            The YAML file.
+        node_name : str, optional
+            The node whose parameters a ROS parameter file gives.
+
+        Returns
+        -------
+        PipelineConfig
+            The configuration.
+
+        Raises
+        ------
+        ValueError
+            Naming the file, for a file that cannot be read or holds invalid values.
+        """
         params = read_parameter_file(path, node_name)
         try:
             return cls.from_dict(read_yaml(path)) if params is None else cls.from_parameters(params)
@@ -80,7 +141,13 @@ class PipelineConfig:
             raise ValueError(f"config {path}: {exc}") from None
 
     def to_dict(self) -> dict:
-        """Plain values (groups as mappings); round-trips through :meth:`from_dict`."""
+        """Plain values, which round-trip through :meth:`from_dict`.
+
+        Returns
+        -------
+        dict
+            Parameter name -> value, the groups as mappings.
+        """
         d = {f.name: getattr(self, f.name) for f in fields(self)}
         for name in GROUPS:
             d[name] = getattr(self, name).to_dict()

@@ -30,7 +30,19 @@ class Part(enum.Enum):
 
 @dataclass(frozen=True)
 class Status:
-    """One diagnostic status about ``part``, with the values behind it (strings)."""
+    """One diagnostic status about ``part``, with the values behind it.
+
+    Parameters
+    ----------
+    part : Part
+        What the status is about.
+    level : Level
+        OK, WARN or ERROR.
+    message : str
+        The status in one line.
+    values : dict
+        The values behind it, as strings.
+    """
 
     part: Part
     level: Level
@@ -38,11 +50,34 @@ class Status:
     values: dict
 
     def name(self, prefix: str) -> str:
+        """The status's name, ``<prefix>: <part>``.
+
+        Parameters
+        ----------
+        prefix : str
+            The node's name.
+
+        Returns
+        -------
+        str
+            The name.
+        """
         return f"{prefix}: {self.part.value}"
 
 
 def statuses(d: dict) -> list[Status]:
-    """The tracking, image input, IMU and camera_info statuses of a :meth:`TrackingPipeline.diagnostics` snapshot."""
+    """The tracking, image input, IMU and camera_info statuses of a diagnostics snapshot.
+
+    Parameters
+    ----------
+    d : dict
+        A :meth:`TrackingPipeline.diagnostics` snapshot.
+
+    Returns
+    -------
+    list of Status
+        The four statuses, in that order.
+    """
     fmt = {k: (f"{v:.3f}" if isinstance(v, float) else str(v)) for k, v in d.items()}
 
     def vals(*keys):
@@ -111,7 +146,18 @@ def _camera(d: dict) -> tuple[Level, str]:
 
 
 def rate_hz(stamps) -> float:
-    """Frames per second of message stamps (ns) over their span; nan with fewer than two."""
+    """Frames per second of message stamps over their span.
+
+    Parameters
+    ----------
+    stamps : sequence of int
+        Stamps, ns.
+
+    Returns
+    -------
+    float
+        The rate; nan with fewer than two stamps (or no span).
+    """
     if len(stamps) < 2:
         return math.nan
     span = (max(stamps) - min(stamps)) * 1e-9

@@ -13,8 +13,23 @@ TRACKING, LOST, INIT, GYRO = (0, 200, 0), (0, 0, 255), (255, 200, 0), (0, 220, 2
 
 
 def draw_result(frame: np.ndarray, r: FrameResult) -> np.ndarray:
-    """BGR copy of ``frame`` with ``r`` drawn: the box (green tracking, red lost, light blue on the
-    init frame), the gyro's predicted box (thin, yellow) and a line with the stamp and state."""
+    """A tracking result drawn on a BGR copy of its frame.
+
+    The box (green tracking, red lost, light blue on the init frame), the gyro's predicted box (thin, yellow) and a line
+    with the stamp and state.
+
+    Parameters
+    ----------
+    frame : ndarray
+        HxW grey or HxWx3 BGR uint8 frame.
+    r : FrameResult
+        The frame's result.
+
+    Returns
+    -------
+    ndarray
+        The HxWx3 BGR drawing.
+    """
     img = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR) if frame.ndim == 2 else frame.copy()
     if r.gyro_box is not None:
         _rect(img, r.gyro_box, GYRO, 1)

@@ -21,17 +21,50 @@ class ImuWait:
 
     @property
     def wait_ns(self) -> int:
+        """The longest wait, ns (the pipeline's ``imu_wait_ms``)."""
         return int(round(self._pipeline.config.imu_wait_ms * 1e6))
 
     def ready(self, stamp_ns: int) -> bool:
-        """Whether the frame stamped ``stamp_ns`` loses nothing by going now (the gyro covers it, or no prior
-        can be used)."""
+        """Whether the frame stamped ``stamp_ns`` loses nothing by going now.
+
+        Parameters
+        ----------
+        stamp_ns : int
+            The frame's stamp, camera clock, ns.
+
+        Returns
+        -------
+        bool
+            True when the gyro covers it, or no prior can be used.
+        """
         return self._pipeline.gyro_ready(stamp_ns)
 
     def waited_out(self, arrival_ns: int, now_ns: int) -> bool:
-        """Whether a frame that arrived at ``arrival_ns`` has waited its longest at ``now_ns``."""
+        """Whether a frame that arrived at ``arrival_ns`` has waited its longest at ``now_ns``.
+
+        Parameters
+        ----------
+        arrival_ns, now_ns : int
+            Times on the caller's clock, ns.
+
+        Returns
+        -------
+        bool
+            True once more than ``imu_wait_ms`` has passed.
+        """
         return now_ns - arrival_ns > self.wait_ns
 
     def remaining_s(self, arrival_ns: int, now_ns: int) -> float:
-        """Seconds the frame that arrived at ``arrival_ns`` may still wait at ``now_ns`` (<= 0: none)."""
+        """Seconds the frame that arrived at ``arrival_ns`` may still wait at ``now_ns``.
+
+        Parameters
+        ----------
+        arrival_ns, now_ns : int
+            Times on the caller's clock, ns.
+
+        Returns
+        -------
+        float
+            Seconds left (<= 0: none).
+        """
         return (arrival_ns + self.wait_ns - now_ns) * 1e-9

@@ -13,8 +13,15 @@ def read_parameter_file(path, node_name: str = NODE_NAME) -> dict | None:
     """The parameters of the node ``node_name`` in the YAML file ``path``, by dotted name (``tracker.n_iter``).
 
     The ``ros__parameters`` of wildcard sections (``/**``) apply, then those of the node's own section (under
-    namespaces too), parameter by parameter as rcl merges them.  A file with one named section is read whatever
-    that name (a renamed node's file).
+    namespaces too), parameter by parameter as rcl merges them.  A file with one named section is read whatever that
+    name (a renamed node's file).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The YAML file.
+    node_name : str, optional
+        The node whose section is read.
 
     Returns
     -------
@@ -48,7 +55,23 @@ def read_parameter_file(path, node_name: str = NODE_NAME) -> dict | None:
 
 
 def read_yaml(path) -> dict:
-    """A YAML file holding a mapping; ValueError naming the file otherwise."""
+    """A YAML file holding a mapping.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The YAML file.
+
+    Returns
+    -------
+    dict
+        Its contents ({} for an empty file).
+
+    Raises
+    ------
+    ValueError
+        Naming the file, when it cannot be read or does not hold a mapping.
+    """
     import yaml  # noqa: PLC0415 - only the command-line tools and the node read parameter files
 
     path = Path(path)

@@ -59,7 +59,23 @@ def _ms(ns: float) -> str:
 
 
 class TrackingPipeline:
-    """Tracker + gyro predictor fed message by message (see the module docstring)."""
+    """Tracker + gyro predictor fed message by message (see the module docstring).
+
+    The first pipeline of a process compiles the tracker's and the gyro's numba kernels (or loads them from numba's
+    cache) at its start-up, not on the first frames.
+
+    Parameters
+    ----------
+    config : PipelineConfig, optional
+        Default ``PipelineConfig()``.
+    camera : CameraModel, optional
+        The calibration, if known (else :meth:`set_camera` later).
+
+    Raises
+    ------
+    ValueError
+        For a ``config`` that is not a PipelineConfig.
+    """
 
     def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
         _warm_up_once()
@@ -92,22 +108,40 @@ class TrackingPipeline:
     # ------------------------------------------------------------------ configuration
     @property
     def config(self) -> PipelineConfig:
+        """The current configuration."""
         return self._cfg
 
     @property
     def state(self) -> TrackState:
+        """The tracking state."""
         return self._state
 
     @property
     def camera(self) -> CameraModel | None:
+        """The camera model of the gyro prior (None until one is set)."""
         return self._predictor.camera
 
     def configure(self, config: PipelineConfig) -> str:
-        """Apply a new configuration; returns a one-line summary of what changed.
+        """Apply a new configuration.
 
-        A changed tracker configuration restarts the tracker at its current window on the frame that
-        window belongs to (the template is taken again there); a changed gyro configuration rebuilds
-        the predictor, keeping the buffered IMU samples.
+        A changed tracker configuration restarts the tracker at its current window on the frame that window belongs to
+        (the template is taken again there); a changed gyro configuration rebuilds the predictor, keeping the buffered
+        IMU samples.
+
+        Parameters
+        ----------
+        config : PipelineConfig
+            The new configuration.
+
+        Returns
+        -------
+        str
+            A one-line summary of what changed.
+
+        Raises
+        ------
+        ValueError
+            For a ``config`` that is not a PipelineConfig.
         """
         if not isinstance(config, PipelineConfig):
             raise ValueError("config must be a PipelineConfig")
@@ -130,7 +164,23 @@ class TrackingPipeline:
 
     # ------------------------------------------------------------------ inputs
     def set_camera(self, camera: CameraModel) -> bool:
-        """Use ``camera`` (K, D) for the gyro prior; returns True when it differs from the current one."""
+        """Use ``camera`` (K, D) for the gyro prior.
+
+        Parameters
+        ----------
+        camera : CameraModel
+            The calibration.
+
+        Returns
+        -------
+        bool
+            True when it differs from the current one.
+
+        Raises
+        ------
+        ValueError
+            For a ``camera`` that is not a CameraModel.
+        """
         if not isinstance(camera, CameraModel):
             raise ValueError(f"camera must be a CameraModel, got {type(camera).__name__}")
         with self._lock:
@@ -144,7 +194,13 @@ class TrackingPipeline:
             return True
 
     def note_bad_camera_info(self, reason: str) -> None:
-        """Record a CameraInfo message that could not be used (the previous camera, if any, stays)."""
+        """Record a CameraInfo message that could not be used (the previous camera, if any, stays).
+
+        Parameters
+        ----------
+        reason : str
+            Why it could not be used.
+        """
         with self._lock:
             self.counters["camera_infos_rejected"] += 1
             self._last["camera_error"] = reason
@@ -157,12 +213,28 @@ class TrackingPipeline:
             self._predictor.add_imu(t, w)
 
     def add_imu(self, t_ns: int, gyro_xyz) -> bool:
-        """Add one gyro sample (IMU clock, ns; IMU-frame rate in rad/s).  Returns False if rejected.
+        """Add one gyro sample.
 
-        Non-finite rates and saturated samples are rejected and counted (the IMU buffer screens them);
-        an accepted stamp earlier than the newest one is counted (the buffer puts it in order) and, if
-        earlier by more than ``clock_reset_ms``, restarts the IMU buffer (a clock reset).
-        ``last_reasons()['imu_reason']`` says why.  ValueError if ``gyro_xyz`` is not 3 values.
+        Non-finite rates and saturated samples are rejected and counted (the IMU buffer screens them); an accepted stamp
+        earlier than the newest one is counted (the buffer puts it in order) and, if earlier by more than
+        ``clock_reset_ms``, restarts the IMU buffer (a clock reset).  ``last_reasons()['imu_reason']`` says why.
+
+        Parameters
+        ----------
+        t_ns : int
+            Stamp, IMU clock, ns.
+        gyro_xyz : array_like
+            IMU-frame rate in rad/s, 3 values.
+
+        Returns
+        -------
+        bool
+            False if the sample was rejected.
+
+        Raises
+        ------
+        ValueError
+            If ``gyro_xyz`` is not 3 values.
         """
         t = int(t_ns)
         w = np.asarray(gyro_xyz, dtype=float).ravel()
@@ -203,14 +275,40 @@ class TrackingPipeline:
         return False
 
     def add_imu_message(self, t_ns: int, angular_velocity_xyz, angular_velocity_covariance0: float) -> bool:
-        """A sensor_msgs/Imu's rates: REP 145's covariance[0] = -1 means "no angular velocity"."""
+        """Add a sensor_msgs/Imu's rates: REP 145's covariance[0] = -1 means "no angular velocity".
+
+        Parameters
+        ----------
+        t_ns : int
+            The message's stamp, ns.
+        angular_velocity_xyz : array_like
+            Its angular velocity, rad/s.
+        angular_velocity_covariance0 : float
+            Its ``angular_velocity_covariance[0]``.
+
+        Returns
+        -------
+        bool
+            False if the message was rejected (no angular velocity, or as :meth:`add_imu`).
+
+        Raises
+        ------
+        ValueError
+            If the angular velocity is not 3 values.
+        """
         if angular_velocity_covariance0 == -1.0:
             self.note_bad_imu("IMU message has angular_velocity_covariance[0] = -1: no angular velocity")
             return False
         return self.add_imu(t_ns, angular_velocity_xyz)
 
     def note_bad_imu(self, reason: str) -> None:
-        """Count an IMU message that carries no usable rate (e.g. covariance[0] = -1: no gyro)."""
+        """Count an IMU message that carries no usable rate (e.g. covariance[0] = -1: no gyro).
+
+        Parameters
+        ----------
+        reason : str
+            Why it carries none.
+        """
         with self._lock:
             self.counters["imu_received"] += 1
             self._reject_imu("imu_rejected", reason)
@@ -220,7 +318,15 @@ class TrackingPipeline:
         return GyroPredictor(self._predictor.camera, self._cfg.gyro)
 
     def note_dropped(self, stamp_ns: int, reason: str = "a newer frame arrived before this one was processed") -> None:
-        """Count a frame the caller skipped (e.g. stale: processing fell behind)."""
+        """Count a frame the caller skipped (e.g. stale: processing fell behind).
+
+        Parameters
+        ----------
+        stamp_ns : int
+            The frame's stamp, ns.
+        reason : str, optional
+            Why it was skipped.
+        """
         with self._lock:
             self.counters["frames_received"] += 1
             self.counters["frames_dropped"] += 1
@@ -228,8 +334,20 @@ class TrackingPipeline:
             self._recent.append((int(stamp_ns), "dropped"))
 
     def note_bad_image(self, reason: str, stamp_ns: int | None = None) -> FrameResult | None:
-        """Count an image message that could not be converted (wrong encoding, step or size, or no decode); returns
-        its result (rejected as malformed; None without a stamp)."""
+        """Count an image message that could not be converted (wrong encoding, step or size, or no decode).
+
+        Parameters
+        ----------
+        reason : str
+            Why it could not be converted.
+        stamp_ns : int, optional
+            The message's stamp, if known.
+
+        Returns
+        -------
+        FrameResult or None
+            The frame's result, rejected as malformed; None without a stamp.
+        """
         with self._lock:
             self.counters["frames_received"] += 1
             self.counters["images_malformed"] += 1
@@ -243,18 +361,47 @@ class TrackingPipeline:
 
     # ------------------------------------------------------------------ tracking
     def gyro_ready(self, stamp_ns: int) -> bool:
-        """True when processing the frame now loses nothing: the gyro covers it, or no prior can be
-        used anyway (gyro off, no camera, no target).  False: waiting for IMU samples may help."""
+        """True when processing the frame now loses nothing.
+
+        The gyro covers it, or no prior can be used anyway (gyro off, no camera, no target).  False: waiting for IMU
+        samples may help.
+
+        Parameters
+        ----------
+        stamp_ns : int
+            The frame's stamp, camera clock, ns.
+
+        Returns
+        -------
+        bool
+            Whether the frame may go now.
+        """
         with self._lock:
             if not self._cfg.use_gyro or self._predictor.camera is None or self._ref is None:
                 return True
             return self._predictor.ready(int(stamp_ns))
 
     def init(self, frame: np.ndarray, box, stamp_ns: int) -> FrameResult:
-        """(Re)start tracking the target ``box`` = (x, y, w, h) in ``frame`` stamped ``stamp_ns``.
+        """(Re)start tracking the target ``box`` in ``frame`` stamped ``stamp_ns``.
 
-        Returns the frame's result: ``box``, score 1, ``is_init``, ``reason`` :data:`INIT_REASON`.  Raises
-        ValueError for a bad frame or box (the previous target, if any, is kept then).
+        Parameters
+        ----------
+        frame : ndarray
+            HxW or HxWx3 (BGR) uint8 frame.
+        box : sequence of 4 float
+            (x, y, w, h), 0-based top-left corner and size in pixels.
+        stamp_ns : int
+            The frame's stamp, camera clock, ns.
+
+        Returns
+        -------
+        FrameResult
+            The frame's result: ``box``, score 1, ``is_init``, ``reason`` :data:`INIT_REASON`.
+
+        Raises
+        ------
+        ValueError
+            For a bad frame or box (the previous target, if any, is kept then).
         """
         with self._track_lock:
             tracker = IemdTracker(self._cfg.tracker)
@@ -280,7 +427,25 @@ class TrackingPipeline:
             self.counters["resets"] += 1
 
     def process(self, frame: np.ndarray, stamp_ns: int) -> FrameResult:
-        """Track into ``frame`` (stamped ``stamp_ns``, camera clock); see :class:`FrameResult`."""
+        """Track into ``frame``.
+
+        Parameters
+        ----------
+        frame : ndarray
+            HxW or HxWx3 (BGR) uint8 frame.
+        stamp_ns : int
+            The frame's stamp, camera clock, ns.
+
+        Returns
+        -------
+        FrameResult
+            The frame's result; see :class:`FrameResult`.
+
+        Raises
+        ------
+        ValueError
+            For a bad frame.
+        """
         t = int(stamp_ns)
         with self._track_lock:
             with self._lock:
@@ -379,12 +544,24 @@ class TrackingPipeline:
 
     # ------------------------------------------------------------------ diagnostics
     def last_reasons(self) -> dict:
-        """Latest explanations: frame_reason, gyro_reason, imu_reason, image_error, camera_error, drop_reason."""
+        """Latest explanations.
+
+        Returns
+        -------
+        dict
+            The texts frame_reason, gyro_reason, imu_reason, image_error, camera_error, drop_reason.
+        """
         with self._lock:
             return dict(self._last)
 
     def diagnostics(self) -> dict:
-        """Snapshot: counters, state, latest reasons and recent rates (stamps-based) and timings."""
+        """Snapshot of the pipeline's state for the diagnostics.
+
+        Returns
+        -------
+        dict
+            Counters, state, latest reasons and recent rates (stamps-based) and timings.
+        """
         with self._lock:
             d = dict(self.counters)
             d.update(self._last)
@@ -416,5 +593,11 @@ class TrackingPipeline:
             return d
 
     def statuses(self) -> list[Status]:
-        """The OK/WARN/ERROR statuses of this moment (:func:`iemd_ros.pipeline.diagnostics.statuses`)."""
+        """The OK/WARN/ERROR statuses of this moment (:func:`iemd_ros.pipeline.diagnostics.statuses`).
+
+        Returns
+        -------
+        list of Status
+            Tracking, image input, IMU and camera_info.
+        """
         return statuses(self.diagnostics())

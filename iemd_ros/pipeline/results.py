@@ -31,12 +31,55 @@ class FrameResult:
     """Outcome of one frame.
 
     ``box``/``angle``/``emd``/``iterations``/``held``/``cause`` come from the tracker
-    (:class:`~iemd_ros.tracking.TrackResult`; the best window searched, also when lost): ``angle`` (radians) is
-    the window's turn, which the gyro priors change (mostly the camera's roll), and ``box`` ``(x, y, w, h)`` the
-    axis-aligned bounding box of the turned window.  ``score`` = ``exp(-emd / score_emd_scale)`` while tracking,
-    else 0.  ``gyro_box``: the gyro's predicted window; ``predicted_box``: the tracker's starting window (after the
-    gyro prior).  ``reason`` says why the frame is lost, held, rejected or untracked.  ``processing_ms`` is
+    (:class:`~iemd_ros.tracking.TrackResult`; the best window searched, also when lost).  ``processing_ms`` is
     wall-clock time; everything else depends only on the messages.
+
+    Parameters
+    ----------
+    stamp_ns : int
+        The frame's stamp, camera clock, ns.
+    state : TrackState
+        The pipeline's state after the frame.
+    box : tuple or None
+        ``(x, y, w, h)``, the axis-aligned bounding box of the turned window.
+    emd : float
+        The window's EMD.
+    score : float
+        ``exp(-emd / score_emd_scale)`` while tracking, else 0.
+    iterations : int
+        Descent iterations of the chosen start.
+    lost : bool
+        Whether the tracker reports the target lost.
+    held : bool
+        Tracked, but the models did not learn.
+    cause : Cause or None
+        The kind of ``reason`` (None: tracked and learned).
+    reason : str
+        Why the frame is lost, held, rejected or untracked.
+    rejection : Rejection or None
+        Why the frame was not tracked.
+    gyro_used : bool
+        Whether a gyro prior was used.
+    gyro_reason : str
+        Why the gyro prior was or was not used.
+    gyro_box : tuple or None
+        The gyro's predicted window.
+    predicted_box : tuple or None
+        The tracker's starting window (after the gyro prior).
+    scale : float
+        Relative scale change chosen on the frame.
+    starts : int
+        Starting points searched.
+    codings : int
+        Candidate models built.
+    solver_warnings : int
+        EMD solves that did not end optimal.
+    processing_ms : float
+        Wall-clock time of the tracker's update.
+    angle : float
+        The window's turn (radians), which the gyro priors change (mostly the camera's roll).
+    is_init : bool
+        The result of the frame :meth:`TrackingPipeline.init` started on.
     """
 
     stamp_ns: int
@@ -68,4 +111,11 @@ class FrameResult:
         return self.state is TrackState.TRACKING and self.rejection is None
 
     def as_dict(self) -> dict:
+        """The fields as a dict.
+
+        Returns
+        -------
+        dict
+            Field name -> value (``dataclasses.asdict``).
+        """
         return asdict(self)

@@ -63,13 +63,37 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
          progress: bool | None = False, ros_args: list[str] | None = None) -> PlayStats:
     """Publish ``bag`` with its timing scaled by ``1/rate``.
 
-    ``topics``: only these bag topics (default all); ``remap``: bag topic -> published topic.
-    ``node``: an rclpy node to create the publishers on (default: a new ``iemd_play`` node; rclpy is
-    initialised if needed, with ``ros_args`` (``["--ros-args", ...]``), and shut down again).
+    Parameters
+    ----------
+    bag : path
+        rosbag2 folder or ROS 1 ``.bag``.
+    rate : float
+        Playback rate factor (> 0).
+    topics : list of str, optional
+        Only these bag topics (default all).
+    remap : dict, optional
+        Bag topic -> published topic.
+    delay_s, wait_subscribers_s : float
+        Sleep before playing; wait up to this long until every topic has a subscriber.
+    clock : bool
+        Also publish ``/clock`` with the log times.
+    qos_depth : int
+        Publisher queue depth (reliable, volatile).
+    node : rclpy node, optional
+        Where to create the publishers (default: a new ``iemd_play`` node; rclpy is initialised if needed, with
+        ``ros_args``, and shut down again).
+
+    Returns
+    -------
+    PlayStats
+
+    Raises
+    ------
+    ValueError
+        (BagError) for a bad rate or depth, topics not in the bag, or nothing to play.
     """
     import rclpy
     from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-    from rclpy.serialization import deserialize_message
 
     if not rate > 0:
         raise ValueError(f"--rate must be > 0, got {rate}")
@@ -78,22 +102,9 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
     remap = dict(remap or {})
     reader = open_bag(bag)
     own_init = own_node = False
-    stats = PlayStats()
     pubs: dict = {}
-    clock_pub = None
     try:
-        available = reader.topics
-        wanted = list(available) if not topics else list(topics)
-        missing = [t for t in wanted if t not in available]
-        if missing:
-            raise BagError(f"topic(s) {', '.join(missing)} not in the bag (topics: {', '.join(sorted(available))})")
-        unknown = [t for t in remap if t not in wanted]
-        if unknown:
-            raise BagError(f"--remap of topic(s) not played: {', '.join(unknown)}")
-        conns = [c for c in reader.connections if c.topic in wanted]
-        total = sum(available[t].msgcount for t in wanted)
-        if not conns or total == 0:
-            raise BagError(f"bag {bag} has no message to play")
+        conns, total = _connections(reader, topics, remap, bag)
         classes = {c.msgtype: message_class(c.msgtype) for c in conns}
         if node is None:
             if not rclpy.ok():
@@ -109,49 +120,78 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
         if clock:
             from rosgraph_msgs.msg import Clock
 
-            clock_pub = node.create_publisher(Clock, "/clock", qos)
-        cache: dict = {}
-        dst = ros2_typestore() if not reader.is2 else None
-        convert = {c.msgtype: _cdr_converter(reader, c.msgtype, cache, dst) for c in conns}
+            pubs[_CLOCK] = node.create_publisher(Clock, "/clock", qos)
         if wait_subscribers_s > 0:
             deadline = time.monotonic() + wait_subscribers_s
             while time.monotonic() < deadline and any(p.get_subscription_count() == 0 for p in pubs.values()):
                 time.sleep(0.01)
         if delay_s > 0:
             time.sleep(delay_s)
-        bar = Progress(total, "iemd-play", progress)
-        t0_log = t0_wall = None
-        late_sum = 0.0
-        n = 0
-        for conn, log_t, raw in iter_messages(reader, conns, bag):
-            msg = deserialize_message(convert[conn.msgtype](raw), classes[conn.msgtype])
-            if t0_log is None:
-                t0_log, t0_wall = log_t, time.monotonic()
-            target = t0_wall + (log_t - t0_log) * 1e-9 / rate
-            while (wait := target - time.monotonic()) > 0:
-                time.sleep(min(wait, 0.05))
-            late = (time.monotonic() - target) * 1e3
-            if clock_pub is not None:
-                cm = Clock()
-                cm.clock.sec, cm.clock.nanosec = ns_to_stamp(log_t)
-                clock_pub.publish(cm)
-            pubs[conn.topic].publish(msg)
-            stats.published[conn.topic] = stats.published.get(conn.topic, 0) + 1
-            stats.max_late_ms = max(stats.max_late_ms, late)
-            late_sum += late
-            n += 1
-            stats.bag_s = (log_t - t0_log) * 1e-9
-            bar.update(1)
-        bar.close()
-        stats.wall_s = 0.0 if t0_wall is None else time.monotonic() - t0_wall
-        stats.mean_late_ms = late_sum / n if n else 0.0
-        return stats
+        return _publish_timed(reader, conns, classes, pubs, rate, Progress(total, "iemd-play", progress), bag)
     finally:
         reader.close()
         if own_node and node is not None:
             node.destroy_node()
         elif node is not None:                     # a caller's node: remove what was added to it
-            for pub in [*pubs.values(), *([clock_pub] if clock_pub is not None else [])]:
+            for pub in pubs.values():
                 node.destroy_publisher(pub)
         if own_init:
             rclpy.try_shutdown()
+
+
+_CLOCK = "/clock"  # the publishers' key of the clock
+
+
+def _connections(reader, topics, remap: dict, bag):
+    """(connections to play, their message count) of the ``topics`` asked for; BagError naming what is missing."""
+    available = reader.topics
+    wanted = list(available) if not topics else list(topics)
+    missing = [t for t in wanted if t not in available]
+    if missing:
+        raise BagError(f"topic(s) {', '.join(missing)} not in the bag (topics: {', '.join(sorted(available))})")
+    unknown = [t for t in remap if t not in wanted]
+    if unknown:
+        raise BagError(f"--remap of topic(s) not played: {', '.join(unknown)}")
+    conns = [c for c in reader.connections if c.topic in wanted]
+    total = sum(available[t].msgcount for t in wanted)
+    if not conns or total == 0:
+        raise BagError(f"bag {bag} has no message to play")
+    return conns, total
+
+
+def _publish_timed(reader, conns, classes: dict, pubs: dict, rate: float, bar: Progress, bag) -> PlayStats:
+    """Publish every message at its log time (relative to the first, scaled by ``1/rate``) and say how late."""
+    from rclpy.serialization import deserialize_message
+
+    dst = ros2_typestore() if not reader.is2 else None
+    cache: dict = {}
+    convert = {c.msgtype: _cdr_converter(reader, c.msgtype, cache, dst) for c in conns}
+    clock_pub = pubs.get(_CLOCK)
+    stats = PlayStats()
+    t0_log = t0_wall = None
+    late_sum, n = 0.0, 0
+    for conn, log_t, raw in iter_messages(reader, conns, bag):
+        msg = deserialize_message(convert[conn.msgtype](raw), classes[conn.msgtype])
+        if t0_log is None:
+            t0_log, t0_wall = log_t, time.monotonic()
+        target = t0_wall + (log_t - t0_log) * 1e-9 / rate
+        while (wait := target - time.monotonic()) > 0:
+            time.sleep(min(wait, 0.05))
+        late = (time.monotonic() - target) * 1e3
+        if clock_pub is not None:
+            from rosgraph_msgs.msg import Clock
+
+            cm = Clock()
+            cm.clock.sec, cm.clock.nanosec = ns_to_stamp(log_t)
+            clock_pub.publish(cm)
+        pubs[conn.topic].publish(msg)
+        stats.published[conn.topic] = stats.published.get(conn.topic, 0) + 1
+        stats.max_late_ms = max(stats.max_late_ms, late)
+        late_sum += late
+        n += 1
+        stats.bag_s = (log_t - t0_log) * 1e-9
+        bar.update(1)
+    bar.close()
+    stats.wall_s = 0.0 if t0_wall is None else time.monotonic() - t0_wall
+    stats.mean_late_ms = late_sum / n if n else 0.0
+    return stats

@@ -13,16 +13,60 @@ __all__ = ["search_context", "descend"]
 
 
 def search_context(tracker: IemdTracker, pyramid: ImagePyramid, angle: float = 0.0) -> SearchContext:
-    """The context the tracker's search samples windows in on ``pyramid``'s frame: its current target model and
-    dictionary.  ``CandidateModel(search_context(tracker, pyramid), centre, size).emd()`` scores any window."""
+    """The context the tracker's search samples windows in on a frame: its current target model and dictionary.
+
+    ``CandidateModel(search_context(tracker, pyramid), centre, size).emd()`` scores any window.
+
+    Parameters
+    ----------
+    tracker : IemdTracker
+        An initialized tracker; it is not changed.
+    pyramid : ImagePyramid
+        The frame's pyramid.
+    angle : float, optional
+        Orientation of the windows in the image, radians.
+
+    Returns
+    -------
+    SearchContext
+        The context of the tracker's search on ``pyramid``'s frame.
+
+    Raises
+    ------
+    RuntimeError
+        When the tracker is not initialized.
+    """
     if tracker._center is None:
         raise RuntimeError("search_context() needs an initialized tracker")
     return tracker._context(pyramid, angle)
 
 
 def descend(tracker: IemdTracker, frame: np.ndarray, box) -> TrackResult:
-    """Algorithm 1 alone on ``frame`` from the axis-aligned window ``box`` = (x, y, w, h), at that size, against
-    the tracker's current target model: no other starts, no filter, no scale search; the tracker is unchanged."""
+    """Algorithm 1 alone on ``frame`` from an axis-aligned window, at that size.
+
+    Against the tracker's current target model: no other starts, no filter, no scale search; the tracker is unchanged.
+
+    Parameters
+    ----------
+    tracker : IemdTracker
+        An initialized tracker.
+    frame : ndarray
+        HxW or HxWx3 (BGR) uint8 image.
+    box : sequence of 4 float
+        The starting window (x, y, w, h), 0-based top-left corner and size in pixels.
+
+    Returns
+    -------
+    TrackResult
+        The window the descent converged to, its EMD and cost, and whether it counts as lost.
+
+    Raises
+    ------
+    RuntimeError
+        When the tracker is not initialized.
+    ValueError
+        For a bad frame or box.
+    """
     if tracker._center is None:
         raise RuntimeError("descend() needs an initialized tracker")
     _check_frame(frame)

@@ -20,28 +20,82 @@ import numpy as np
 
 
 def to_gray(frame: np.ndarray) -> np.ndarray:
-    """Grey levels in [0, 1] (float32) of an HxW or HxWx3 (BGR) uint8 frame: the paper's "normalized pixel
-    values" are grey levels (docs/decisions.md#grey-patches-template-size)."""
+    """Grey levels in [0, 1] of a uint8 frame.
+
+    The paper's "normalized pixel values" are grey levels (docs/decisions.md#grey-patches-template-size).
+
+    Parameters
+    ----------
+    frame : ndarray
+        HxW or HxWx3 (BGR) uint8 frame.
+
+    Returns
+    -------
+    ndarray
+        HxW float32 grey levels in [0, 1].
+    """
     return np.multiply(grey_levels(frame), np.float32(1.0 / 255.0), dtype=np.float32)
 
 
 def grey_levels(frame: np.ndarray, copy: bool = False) -> np.ndarray:
-    """HxW uint8 grey levels of an HxW or HxWx3 (BGR) uint8 frame: the frame itself if grey, unless ``copy``
-    (a result to keep, which must not share the caller's buffer)."""
+    """HxW uint8 grey levels of a uint8 frame.
+
+    Parameters
+    ----------
+    frame : ndarray
+        HxW or HxWx3 (BGR) uint8 frame.
+    copy : bool, optional
+        Copy a grey frame rather than return it: for a result to keep, which must not share the caller's buffer.
+
+    Returns
+    -------
+    ndarray
+        HxW uint8 grey levels: the frame itself if it is grey, unless ``copy``.
+    """
     if frame.ndim == 3:
         return cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
     return frame.copy() if copy else frame
 
 
 def window_axes(angle: float) -> np.ndarray:
-    """Rotation taking the axes of a window turned by ``angle`` to image axes (columns: its x and y axes)."""
+    """Rotation taking the axes of a window turned by ``angle`` to image axes.
+
+    Parameters
+    ----------
+    angle : float
+        The window's turn, radians.
+
+    Returns
+    -------
+    ndarray
+        2x2 rotation whose columns are the window's x and y axes in the image.
+    """
     c, s = np.cos(angle), np.sin(angle)
     return np.array([[c, -s], [s, c]])
 
 
 def warp_window(image: np.ndarray, centre, linear: np.ndarray, out_size, interpolation: int = cv2.INTER_LINEAR):
-    """The (Th, Tw) sample of ``image`` whose pixel u (0..T-1 per axis) is the image point
-    ``centre + linear @ (u - (T-1)/2)``, ``out_size`` = (Tw, Th); parts outside the image replicate its border."""
+    """Sample ``image`` on a grid of ``out_size`` pixels mapped affinely around ``centre``.
+
+    Parameters
+    ----------
+    image : ndarray
+        The image to sample.
+    centre : array_like
+        (x, y) image point of the grid's centre.
+    linear : ndarray
+        2x2 linear map of grid pixels to image pixels.
+    out_size : tuple of int
+        (Tw, Th), the sample's size.
+    interpolation : int, optional
+        OpenCV interpolation flag.
+
+    Returns
+    -------
+    ndarray
+        The (Th, Tw) sample whose pixel u (0..T-1 per axis) is the image point ``centre + linear @ (u - (T-1)/2)``;
+        parts outside the image replicate its border.
+    """
     tw, th = (int(v) for v in out_size)
     warp = np.column_stack([linear, np.asarray(centre, dtype=np.float64) - linear @ [(tw - 1) / 2, (th - 1) / 2]])
     return cv2.warpAffine(image, warp, (tw, th), flags=interpolation | cv2.WARP_INVERSE_MAP,
@@ -51,9 +105,17 @@ def warp_window(image: np.ndarray, centre, linear: np.ndarray, out_size, interpo
 class ImagePyramid:
     """Gaussian pyramid of one frame, so large windows are sampled without aliasing.
 
-    A window whose template scale (image pixels per template pixel) is s is
-    sampled bilinearly from level ``floor(log2(s))``, where its scale is in
-    [1, 2): every template pixel then integrates at least one pyrDown-smoothed pixel.
+    A window whose template scale (image pixels per template pixel) is s is sampled bilinearly from level
+    ``floor(log2(s))``, where its scale is in [1, 2): every template pixel then integrates at least one
+    pyrDown-smoothed pixel.  The levels are built on demand (:meth:`level`).
+
+    Parameters
+    ----------
+    gray : ndarray
+        The frame's grey levels (level 0).
+    max_levels : int, optional
+        Most levels above the frame; a level is added only while the one below it has both sides of at least 32
+        pixels.
     """
 
     def __init__(self, gray: np.ndarray, max_levels: int = 4):
@@ -65,24 +127,66 @@ class ImagePyramid:
             self.n_levels += 1
 
     def level(self, index: int) -> np.ndarray:
-        """Pyramid level ``index`` (0: the frame), computed with the ones below it on first use."""
+        """Pyramid level ``index``, computed with the ones below it on first use.
+
+        Parameters
+        ----------
+        index : int
+            Level number, 0 for the frame itself.
+
+        Returns
+        -------
+        ndarray
+            The level's image.
+        """
         while len(self._levels) <= index:
             self._levels.append(cv2.pyrDown(self._levels[-1]))
         return self._levels[index]
 
     def sample(self, center, size, template_size, angle: float = 0.0) -> np.ndarray:
-        """Resample a window to a (Th, Tw) template; ``template_size`` is (Tw, Th).
+        """Resample a window to a template.
 
-        ``angle`` (radians) rotates the window about its centre: its x axis points along (cos, sin) in the
-        image.  Parts outside the image are padded by replicating the border.
+        Parameters
+        ----------
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        template_size : tuple of int
+            (Tw, Th).
+        angle : float, optional
+            Rotation of the window about its centre, radians: its x axis points along (cos, sin) in the image.
+
+        Returns
+        -------
+        ndarray
+            The (Th, Tw) template; parts outside the image are padded by replicating the border.
         """
         level, linear, centre = self._geometry(center, size, template_size, angle)
         return warp_window(self.level(level), centre, linear, template_size)
 
     def sample_scales(self, center, size, template_size, factors, angle: float = 0.0) -> np.ndarray:
-        """The window scaled by each of ``factors`` about its centre, resampled to (Th, Tw) templates:
-        (len(factors), Th, Tw), in one remap from the anti-aliasing level of the unscaled window (the same
-        smoothing at every scale, so the templates differ by their scale only)."""
+        """The window scaled by each of ``factors`` about its centre, resampled to templates.
+
+        One remap from the anti-aliasing level of the unscaled window: the same smoothing at every scale, so the
+        templates differ by their scale only.
+
+        Parameters
+        ----------
+        center, size : array_like
+            The window, as in :meth:`sample`.
+        template_size : tuple of int
+            (Tw, Th).
+        factors : array_like
+            Scale factors of the window.
+        angle : float, optional
+            The window's turn, as in :meth:`sample`.
+
+        Returns
+        -------
+        ndarray
+            (len(factors), Th, Tw) templates.
+        """
         tw, th = template_size
         level, linear, centre = self._geometry(center, size, template_size, angle)
         grid = np.stack(np.meshgrid(np.arange(tw) - (tw - 1) / 2, np.arange(th) - (th - 1) / 2))  # (2, Th, Tw)
@@ -108,7 +212,24 @@ class ImagePyramid:
 
 @dataclass(frozen=True)
 class PatchLayout:
-    """Local patches m x n with step s over a template (paper: 8x8 step 4 on 32x32)."""
+    """Local patches m x n with step s over a template (paper: 8x8 step 4 on 32x32).
+
+    Parameters
+    ----------
+    template_size : tuple of int
+        (Tw, Th).
+    patch_size : tuple of int
+        (m, n) = (width, height).
+    step : int
+        Stride between patches, template pixels.
+    min_contrast : float, optional
+        Grey-level standard deviation below which a patch counts as flat (docs/decisions.md#patch-normalization).
+
+    Raises
+    ------
+    ValueError
+        When the patches do not fit the template or the step is below 1.
+    """
 
     template_size: tuple[int, int]  # (Tw, Th)
     patch_size: tuple[int, int]  # (m, n) = (width, height)
@@ -129,8 +250,13 @@ class PatchLayout:
         return (tw - pw) // self.step + 1, (th - ph) // self.step + 1
 
     def positions(self) -> np.ndarray:
-        """(N, 2) normalized centres of the window's patches, row-major like :meth:`extract` (read-only: one
-        array shared by every model of the layout)."""
+        """Normalized centres of the window's patches.
+
+        Returns
+        -------
+        ndarray
+            (N, 2) centres, row-major like :meth:`extract`; read-only: one array shared by every model of the layout.
+        """
         return self._positions
 
     @cached_property
@@ -146,19 +272,53 @@ class PatchLayout:
         return positions
 
     def extract(self, template: np.ndarray) -> np.ndarray:
-        """(N, m*n) appearance vectors epsilon, the paper's "normalized pixel values" (section 4).
+        """Appearance vectors epsilon of a template's patches, the paper's "normalized pixel values" (section 4).
 
-        Each patch is brought to zero mean and unit norm, invariant to local brightness and contrast; a patch
-        whose standard deviation is below ``min_contrast`` is scaled as if it had that contrast (a shorter
-        vector), so flat patches do not amplify noise (docs/decisions.md#patch-normalization).
+        Each patch is brought to zero mean and unit norm, invariant to local brightness and contrast; a patch whose
+        standard deviation is below ``min_contrast`` is scaled as if it had that contrast (a shorter vector), so flat
+        patches do not amplify noise (docs/decisions.md#patch-normalization).
+
+        Parameters
+        ----------
+        template : ndarray
+            (Th, Tw) template.
+
+        Returns
+        -------
+        ndarray
+            (N, m*n) appearance vectors, row-major patches.
+
+        Raises
+        ------
+        ValueError
+            When the template's shape is not the layout's.
         """
         return self.extract_with_jacobian(template, jacobian=False)[0]
 
     def extract_with_jacobian(self, template: np.ndarray, jacobian: bool = True):
-        """epsilon (N, d) and its derivative (N, d, 2) with respect to moving the window.
+        """Appearance vectors epsilon and their derivative with respect to moving the window.
 
-        The derivative is per template pixel of window motion (x, y): the patch pixels' grey-level gradients
-        (central differences of the template) pushed through the normalization.
+        The derivative is per template pixel of window motion (x, y): the patch pixels' grey-level gradients (central
+        differences of the template) pushed through the normalization.
+
+        Parameters
+        ----------
+        template : ndarray
+            (Th, Tw) template.
+        jacobian : bool, optional
+            Compute the derivative (False: epsilon only).
+
+        Returns
+        -------
+        eps : ndarray
+            (N, d) appearance vectors, as :meth:`extract`.
+        jac : ndarray or None
+            (N, d, 2) derivative; None without ``jacobian``.
+
+        Raises
+        ------
+        ValueError
+            When the template's shape is not the layout's.
         """
         template = np.asarray(template, dtype=np.float64)
         if template.shape != self.template_size[::-1]:

@@ -33,11 +33,17 @@ from iemd_ros.tracking.template import TemplateDictionary
 class TargetModel:
     """The target histogram of eq. (sparse target model): the bins that carry mass.
 
-    ``pos`` (N_T, 2) normalized patch centres, ``eps`` (N_T, d) appearance
-    vectors, ``weights`` w_T summing to 1.  Bins outside the kernel (the
-    window's corners) are dropped: they change neither the optimal flow nor
-    the candidate duals, and dropping them once saves the solver's filtering
-    on every solve.
+    Bins outside the kernel (the window's corners) are dropped: they change neither the optimal flow nor the candidate
+    duals, and dropping them once saves the solver's filtering on every solve.
+
+    Parameters
+    ----------
+    pos : ndarray
+        (N_T, 2) normalized patch centres.
+    eps : ndarray
+        (N_T, d) appearance vectors.
+    weights : ndarray
+        (N_T,) weights w_T, summing to 1.
     """
 
     pos: np.ndarray
@@ -46,6 +52,29 @@ class TargetModel:
 
     @classmethod
     def from_patches(cls, pos, eps, code_weights, bandwidth: float) -> "TargetModel":
+        """The target model of a window's patches, without the bins outside the kernel.
+
+        Parameters
+        ----------
+        pos : array_like
+            (N, 2) normalized patch centres.
+        eps : array_like
+            (N, d) appearance vectors.
+        code_weights : ndarray
+            (N,) pooled code weights of the patches.
+        bandwidth : float
+            The kernel's h.
+
+        Returns
+        -------
+        TargetModel
+            The bins of non-zero weight w_T (:func:`~iemd_ros.tracking.histogram.target_weights`).
+
+        Raises
+        ------
+        ValueError
+            When no patch with a non-zero code is inside the kernel.
+        """
         weights = target_weights(code_weights, pos, bandwidth)
         keep = np.flatnonzero(weights > 0)
         return cls(pos=np.asarray(pos, dtype=np.float64)[keep], eps=np.asarray(eps, dtype=np.float64)[keep],
@@ -61,11 +90,23 @@ class TargetModel:
 class SearchContext:
     """What the candidate windows of one search on one frame are sampled from and compared against.
 
-    The windows are resampled from ``pyramid`` turned by ``angle`` (see ImagePyramid.sample; positions and
-    gradients are in the window's own axes) and cut into patches by ``layout``.  ``dictionary`` codes the patches
-    (:meth:`TemplateDictionary.code_weights`); None gives every patch code weight 1, so that only the kernel
-    weights bins.  ``alpha`` weighs appearance against space in the ground distance; ``bandwidth`` is the
-    kernel's h.
+    Parameters
+    ----------
+    pyramid : ImagePyramid
+        The frame the windows are resampled from, turned by ``angle`` (see :meth:`ImagePyramid.sample`).
+    layout : PatchLayout
+        Cuts the windows into patches.
+    target : TargetModel
+        The target histogram the windows are compared against.
+    dictionary : TemplateDictionary or None
+        Codes the patches (:meth:`TemplateDictionary.code_weights`); None gives every patch code weight 1, so that only
+        the kernel weights bins.
+    alpha : float
+        Weight of appearance against space in the ground distance.
+    bandwidth : float
+        The kernel's h.
+    angle : float, optional
+        Orientation of the windows in the image, radians; positions and gradients are in the window's own axes.
     """
 
     pyramid: ImagePyramid
@@ -78,7 +119,17 @@ class SearchContext:
 
 
 class CandidateModel:
-    """Patches, sparse codes and pooled weights of the window at ``center`` with ``size`` in a search ``context``."""
+    """Patches, sparse codes and pooled weights of one window in a search context.
+
+    Parameters
+    ----------
+    context : SearchContext
+        Frame, target, dictionary and orientation of the search.
+    center : array_like
+        (x, y) window centre, image pixels.
+    size : array_like
+        (w, h) window size, image pixels.
+    """
 
     def __init__(self, context: SearchContext, center, size):
         self.context = context
@@ -98,24 +149,58 @@ class CandidateModel:
         return self.context.angle
 
     def at(self, center, size=None) -> "CandidateModel":
-        """The model in the same context (frame, target, dictionary, orientation) at another window:
-        Algorithm 1's next iterate, or a scale variant when ``size`` is given."""
+        """The model in the same context (frame, target, dictionary, orientation) at another window.
+
+        Algorithm 1's next iterate, or a scale variant when ``size`` is given.
+
+        Parameters
+        ----------
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like, optional
+            (w, h) window size (default: this model's).
+
+        Returns
+        -------
+        CandidateModel
+            The model at the new window.
+        """
         return CandidateModel(self.context, center, self.size if size is None else size)
 
     @cached_property
     def patch_jacobian(self) -> np.ndarray:
         """d epsilon / d(window shift along its axes), per template pixel, (N, d, 2).
 
-        Computed on first use: the descent needs it only where a step is accepted
-        (about 4 in 10 models; rejected trials and scale variants need only the EMD).
+        Computed on first use: the descent needs it only where a step is accepted (rejected trials and scale variants
+        need only the EMD).
         """
         return self.context.layout.extract_with_jacobian(self.template)[1]
 
     def evaluate(self, gradient: str, y=(0.0, 0.0)):
-        """EMD between the target and the kernel centred at offset ``y`` (normalized), and dEMD/dy.
+        """EMD between the target and the kernel centred at offset ``y``, and dEMD/dy.
 
-        Returns (emd, gradient (2,) per normalized unit, EmdSolution or None when
-        no bin has weight): :meth:`emd` then :meth:`gradient`.
+        :meth:`emd` then :meth:`gradient`.
+
+        Parameters
+        ----------
+        gradient : {"paper", "appearance"}
+            Kind of gradient, as :meth:`gradient` takes it.
+        y : array_like, optional
+            (2,) kernel offset, normalized window units.
+
+        Returns
+        -------
+        emd : float
+            The EMD; inf when no bin has weight.
+        gradient : ndarray
+            (2,) dEMD/dy per normalized unit; zeros when no bin has weight.
+        solution : EmdSolution or None
+            The solved transport; None when no bin has weight.
+
+        Raises
+        ------
+        ValueError
+            For an unknown ``gradient``, or the appearance gradient away from y = 0.
         """
         value, solution = self.emd(y)
         if solution is None:
@@ -123,8 +208,22 @@ class CandidateModel:
         return value, self.gradient(gradient), solution
 
     def emd(self, y=(0.0, 0.0)):
-        """(EMD, EmdSolution) between the target and the kernel centred at offset ``y``; (inf, None)
-        when no bin has weight.  The solution is kept for :meth:`gradient` (and reused at the same ``y``)."""
+        """EMD between the target and the kernel centred at offset ``y``.
+
+        The solution is kept for :meth:`gradient` (and reused at the same ``y``).
+
+        Parameters
+        ----------
+        y : array_like, optional
+            (2,) kernel offset, normalized window units.
+
+        Returns
+        -------
+        value : float
+            The EMD; inf when no bin has weight.
+        solution : EmdSolution or None
+            The solved transport; None when no bin has weight.
+        """
         y = np.asarray(y, dtype=np.float64)
         if self._solved is not None and np.array_equal(self._solved[0], y):
             return self._solved[3].value, self._solved[3]
@@ -139,15 +238,27 @@ class CandidateModel:
         return solution.value, solution
 
     def gradient(self, kind: str) -> np.ndarray:
-        """dEMD/dy (2,) per normalized unit at the last :meth:`emd`'s offset.  ``kind``:
+        """dEMD/dy at the last :meth:`emd`'s offset.
 
-        - "paper": eq. (10), the duals times dw_C/dy (patches fixed, kernel moves);
-        - "appearance": the derivative of the re-sampled model that Algorithm 1
-          evaluates (only at y = 0): when the window moves its patches are
-          re-sampled, so d_uv changes through epsilon_v(y); with the flow fixed
-          (envelope theorem) dD*/dy = -2 alpha sum_v (sum_u f_uv eps_u - w_v eps_v)
-          . d eps_v/dy.  The pooled code weights also move with the content; that
-          term is left out (they change slowly and have no closed-form derivative).
+        Parameters
+        ----------
+        kind : {"paper", "appearance"}
+            - "paper": eq. (10), the duals times dw_C/dy (patches fixed, kernel moves);
+            - "appearance": the derivative of the re-sampled model that Algorithm 1 evaluates (only at y = 0): when the
+              window moves its patches are re-sampled, so d_uv changes through epsilon_v(y); with the flow fixed
+              (envelope theorem) dD*/dy = -2 alpha sum_v (sum_u f_uv eps_u - w_v eps_v) . d eps_v/dy.  The pooled code
+              weights also move with the content; that term is left out (they change slowly and have no closed-form
+              derivative).
+
+        Returns
+        -------
+        ndarray
+            (2,) gradient per normalized unit.
+
+        Raises
+        ------
+        ValueError
+            Before a solved :meth:`emd`, for the appearance gradient away from y = 0, or for an unknown ``kind``.
         """
         if self._solved is None:
             raise ValueError("gradient() needs a solved emd() first")

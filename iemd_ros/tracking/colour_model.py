@@ -26,11 +26,27 @@ from iemd_ros.tracking.appearance import warp_window, window_axes
 
 
 class ColourModel:
-    """``init`` at the target's window, per frame ``estimate`` around the predicted window (then
-    ``score_at`` for candidate centres) and, when the frame is tracked, ``update`` at the tracked window.
+    """Staple's colour model of the target against its surroundings (see the module docstring).
 
-    Frames are HxWx3 uint8 (BGR); windows are (centre, size (w, h), angle) as in
-    :meth:`iemd_ros.tracking.appearance.ImagePyramid.sample`.
+    ``init`` at the target's window, per frame ``estimate`` around the predicted window (then ``score_at`` for
+    candidate centres) and, when the frame is tracked, ``update`` at the tracked window.  Frames are HxWx3 uint8 (BGR);
+    windows are (centre, size (w, h), angle) as in :meth:`iemd_ros.tracking.appearance.ImagePyramid.sample`.
+
+    Parameters
+    ----------
+    padding : float, optional
+        Margin of the search region on every side, times sqrt(w h) of the window; >= 0.
+    learning_rate : float, optional
+        Rate of the histograms' running averages, in (0, 1].
+    bins : int, optional
+        Levels per colour channel, a power of 2 up to 64 (bins**3 histogram entries).
+    model_area : int, optional
+        Most pixels the search region is resampled to.
+
+    Raises
+    ------
+    ValueError
+        For a negative ``padding``, a ``learning_rate`` outside (0, 1] or ``bins`` not a power of 2 up to 64.
     """
 
     def __init__(self, padding: float = 1.0, learning_rate: float = 0.04, bins: int = 32,
@@ -52,16 +68,41 @@ class ColourModel:
 
     @property
     def trained(self) -> bool:
+        """Whether :meth:`init` has learnt the histograms."""
         return self._target is not None
 
     def init(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
-        """Learn the histograms from the window of the first frame."""
+        """Learn the histograms from the window of the first frame.
+
+        Parameters
+        ----------
+        frame : ndarray
+            HxWx3 uint8 (BGR) frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+        """
         self._target, self._surroundings = self._histograms(frame, center, size, angle)
         self._beta = _beta(self._target, self._surroundings)
         self._means = None
 
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
-        """Blend in the histograms at the tracked window."""
+        """Blend in the histograms at the tracked window.
+
+        Parameters
+        ----------
+        frame : ndarray
+            HxWx3 uint8 (BGR) frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+        """
         target, surroundings = self._histograms(frame, center, size, angle)
         eta = self.learning_rate
         self._target = (1.0 - eta) * self._target + eta * target
@@ -69,8 +110,31 @@ class ColourModel:
         self._beta = _beta(self._target, self._surroundings)
 
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
-        """Displacement (dx, dy), image pixels, from ``center`` to the window of ``size`` of highest mean beta in
-        the search region, which the model keeps for :meth:`score_at`."""
+        """Displacement to the window of highest mean beta in the search region around the predicted window.
+
+        The map of mean beta is kept for :meth:`score_at`.
+
+        Parameters
+        ----------
+        frame : ndarray
+            HxWx3 uint8 (BGR) frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+
+        Returns
+        -------
+        ndarray
+            (dx, dy), image pixels, from ``center`` to the window of ``size`` of highest mean beta.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`init`.
+        """
         if not self.trained:
             raise RuntimeError("ColourModel.estimate() called before init()")
         size = np.asarray(size, dtype=np.float64)
@@ -89,8 +153,23 @@ class ColourModel:
         return window_axes(angle) @ ((origin + [c, r]) / scale)
 
     def score_at(self, point) -> float:
-        """The last estimate's mean beta of the window centred at image point ``point`` (bilinear between
-        positions; 0 outside the search region)."""
+        """The last estimate's mean beta of the window centred at an image point.
+
+        Parameters
+        ----------
+        point : array_like
+            (x, y) image point.
+
+        Returns
+        -------
+        float
+            The mean beta, bilinear between window positions; 0 outside the search region.
+
+        Raises
+        ------
+        RuntimeError
+            Before an :meth:`estimate`.
+        """
         if self._means is None:
             raise RuntimeError("ColourModel.score_at() needs an estimate() first")
         means, origin, center, scale, angle = self._means

@@ -17,9 +17,25 @@ FLOOR = 0.05  # added to a cell histogram's norm (gradient magnitudes in grey le
 
 
 class FilterModel:
-    """A multi-channel correlation filter in the Fourier domain (DSST eq. 5), shared by the scale and the
-    translation filter: numerator G conj(F_l) and denominator sum_l |F_l|^2 of the samples learnt, as running
-    averages at ``learning_rate`` (the first sample replaces them), channels along ``channel_axis``."""
+    """Multi-channel correlation filter in the Fourier domain (DSST eq. 5).
+
+    Shared by the scale and the translation filter: numerator G conj(F_l) and denominator sum_l |F_l|^2 of the samples
+    learnt, as running averages at ``learning_rate`` (the first sample replaces them).
+
+    Parameters
+    ----------
+    learning_rate : float
+        Rate of the running averages, in (0, 1].
+    regularization : float
+        Added to the denominator when the filter responds.
+    channel_axis : int
+        Axis of the feature channels in the spectra.
+
+    Raises
+    ------
+    ValueError
+        For a ``learning_rate`` outside (0, 1].
+    """
 
     def __init__(self, learning_rate: float, regularization: float, channel_axis: int):
         if not 0.0 < learning_rate <= 1.0:
@@ -31,13 +47,23 @@ class FilterModel:
 
     @property
     def trained(self) -> bool:
+        """Whether a sample has been learnt since the last :meth:`reset`."""
         return self._numerator is not None
 
     def reset(self) -> None:
+        """Forget the samples learnt."""
         self._numerator = self._denominator = None
 
     def learn(self, desired: np.ndarray, spectrum: np.ndarray) -> None:
-        """Blend in the sample ``spectrum`` with its desired response ``desired``."""
+        """Blend in a sample with its desired response.
+
+        Parameters
+        ----------
+        desired : ndarray
+            Spectrum G of the desired response.
+        spectrum : ndarray
+            Spectra F_l of the sample's channels.
+        """
         numerator = desired * np.conj(spectrum)
         denominator = (spectrum * np.conj(spectrum)).real.sum(self.channel_axis)
         if self._numerator is None:
@@ -48,37 +74,97 @@ class FilterModel:
         self._denominator = (1.0 - eta) * self._denominator + eta * denominator
 
     def response(self, spectrum: np.ndarray) -> np.ndarray:
-        """Spectrum of the filter's response to the sample ``spectrum`` (channels summed)."""
+        """Spectrum of the filter's response to a sample, channels summed.
+
+        Parameters
+        ----------
+        spectrum : ndarray
+            Spectra of the sample's channels.
+
+        Returns
+        -------
+        ndarray
+            The response's spectrum.
+        """
         return (self._numerator * spectrum).sum(self.channel_axis) / (self._denominator + self.regularization)
 
 
 def model_size(size, area: float, min_cells: int) -> tuple[int, int]:
-    """(w, h) in model pixels of a window of ``size`` resampled to about ``area`` pixels with its aspect ratio,
-    whole CELLs and at least ``min_cells`` of them per axis."""
+    """Size in model pixels of a window resampled to about ``area`` pixels with its aspect ratio.
+
+    Parameters
+    ----------
+    size : array_like
+        (w, h) of the window.
+    area : float
+        Number of model pixels aimed at.
+    min_cells : int
+        Least number of CELLs per axis.
+
+    Returns
+    -------
+    tuple of int
+        (w, h) in model pixels: whole CELLs, at least ``min_cells`` of them per axis.
+    """
     w, h = (float(v) for v in size)
     f = np.sqrt(area / (w * h))
     return tuple(int(max(min_cells, round(v * f / CELL))) * CELL for v in (w, h))
 
 
 def hann(n: int) -> np.ndarray:
-    """Hann window of ``n`` samples without its zero ends (every sample keeps some weight)."""
+    """Hann window of ``n`` samples without its zero ends (every sample keeps some weight).
+
+    Parameters
+    ----------
+    n : int
+        Number of samples.
+
+    Returns
+    -------
+    ndarray
+        (n,) weights.
+    """
     return np.hanning(n + 2)[1:-1]
 
 
 def parabola_peak(left: float, centre: float, right: float) -> float:
-    """Offset (in samples, within +-0.5) of the vertex of the parabola through three samples around a
-    maximum ``centre``; 0 when they are not concave."""
+    """Sub-sample offset of a maximum: the vertex of the parabola through three samples around it.
+
+    Parameters
+    ----------
+    left, centre, right : float
+        Three consecutive samples, ``centre`` the maximum.
+
+    Returns
+    -------
+    float
+        Offset of the vertex from ``centre``, in samples, within +-0.5; 0 when the samples are not concave.
+    """
     curvature = left - 2.0 * centre + right
     return 0.5 * (left - right) / curvature if curvature < 0 else 0.0
 
 
 def orientation_histograms(windows: np.ndarray) -> np.ndarray:
-    """Per window of ``windows`` (S, H, W), its gradient-orientation histograms as one vector (S, d).
+    """Gradient-orientation histograms of each window, as one vector per window.
 
-    Central-difference gradients (one-sided at the border); unsigned orientations in ``N_ORIENTATIONS``
-    bins, weighted by the gradient magnitude, summed over CELL x CELL cells; each cell's histogram divided
-    by its L2 norm plus a floor (flat cells stay short): a HOG without blocks, invariant to brightness
-    and contrast.  H and W are multiples of CELL.
+    Central-difference gradients (one-sided at the border); unsigned orientations in ``N_ORIENTATIONS`` bins, weighted
+    by the gradient magnitude, summed over CELL x CELL cells; each cell's histogram divided by its L2 norm plus a floor
+    (flat cells stay short): a HOG without blocks, invariant to brightness and contrast.
+
+    Parameters
+    ----------
+    windows : ndarray
+        (S, H, W) windows; H and W are multiples of CELL.
+
+    Returns
+    -------
+    ndarray
+        (S, d) features.
+
+    Raises
+    ------
+    ValueError
+        When H or W is not a multiple of CELL.
     """
     windows = np.ascontiguousarray(windows, dtype=np.float32)
     n, h, w = windows.shape

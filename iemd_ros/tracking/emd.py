@@ -21,6 +21,24 @@ _RESULT_MESSAGES = {0: "infeasible", 1: "optimal", 2: "unbounded",
 
 @dataclass
 class EmdSolution:
+    """Result of :func:`solve_emd`: the optimal transport and its duals.
+
+    Parameters
+    ----------
+    value : float
+        D*, eq. (4).
+    flow : ndarray
+        The flow f_uv, (N_T, N_C).
+    u : ndarray
+        Dual potentials of the target constraints, eq. (6).
+    v : ndarray
+        Dual potentials of the candidate constraints, eq. (5).
+    optimal : bool
+        Whether the solver ended optimal.
+    message : str
+        The solver's exit in words ("optimal", "infeasible", "unbounded", "max_iter reached before optimality", or
+        the result code).
+    """
     value: float  # D*, eq. (4)
     flow: np.ndarray  # f_uv, (N_T, N_C)
     u: np.ndarray  # dual potentials of the target constraints, eq. (6)
@@ -30,14 +48,45 @@ class EmdSolution:
 
 
 def ground_distance(eps_t, pos_t, eps_c, pos_c, alpha: float) -> np.ndarray:
-    """d_uv = alpha ||eps_u - eps_v||^2 + (1 - alpha) ||c_u - c_v||^2 (eq. ground distance)."""
+    """Ground distance d_uv = alpha ||eps_u - eps_v||^2 + (1 - alpha) ||c_u - c_v||^2 (eq. ground distance).
+
+    Parameters
+    ----------
+    eps_t : ndarray
+        (N_T, d) appearance vectors of the target bins.
+    pos_t : ndarray
+        (N_T, 2) positions of the target bins.
+    eps_c : ndarray
+        (N_C, d) appearance vectors of the candidate bins.
+    pos_c : ndarray
+        (N_C, 2) positions of the candidate bins.
+    alpha : float
+        Weight of appearance against space.
+
+    Returns
+    -------
+    ndarray
+        (N_T, N_C) distances.
+    """
     return alpha * appearance_distance(eps_t, eps_c) + (1.0 - alpha) * spatial_distance(pos_t, pos_c)
 
 
 def appearance_distance(eps_t, eps_c, sq_norms_t=None) -> np.ndarray:
-    """||eps_u - eps_v||^2 for all pairs (rows of ``eps_t`` x rows of ``eps_c``).
+    """Squared appearance distances ||eps_u - eps_v||^2 for all pairs (rows of ``eps_t`` x rows of ``eps_c``).
 
-    ``sq_norms_t``: the rows' squared norms of ``eps_t`` if already known (the target's, per candidate).
+    Parameters
+    ----------
+    eps_t : ndarray
+        (N_T, d) rows u.
+    eps_c : ndarray
+        (N_C, d) rows v.
+    sq_norms_t : ndarray, optional
+        The rows' squared norms of ``eps_t`` if already known (the target's, per candidate).
+
+    Returns
+    -------
+    ndarray
+        (N_T, N_C) squared distances (negative rounding clipped to 0).
     """
     if sq_norms_t is None:
         sq_norms_t = (eps_t**2).sum(1)
@@ -46,7 +95,18 @@ def appearance_distance(eps_t, eps_c, sq_norms_t=None) -> np.ndarray:
 
 
 def spatial_distance(pos_t, pos_c) -> np.ndarray:
-    """||c_u - c_v||^2 for all pairs of (N, 2) positions."""
+    """Squared distances ||c_u - c_v||^2 for all pairs of positions.
+
+    Parameters
+    ----------
+    pos_t, pos_c : ndarray
+        (N_T, 2) and (N_C, 2) positions.
+
+    Returns
+    -------
+    ndarray
+        (N_T, N_C) squared distances.
+    """
     diff = pos_t[:, None, :] - pos_c[None, :, :]
     return (diff**2).sum(-1)
 
@@ -55,10 +115,30 @@ def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int 
               check: bool = True) -> EmdSolution:
     """Optimal transport of the normalized weights ``w_t`` onto ``w_c`` under ``cost``.
 
-    Raises ValueError for weights that are negative, not finite or of different totals.
-    ``check=False`` skips those checks (a third of the call's time) and the repair of the duals of
-    zero-weight bins, for callers that build valid inputs with positive weights only, like the
-    candidate model.
+    Parameters
+    ----------
+    w_t : ndarray
+        (N_T,) target weights.
+    w_c : ndarray
+        (N_C,) candidate weights, of the same total.
+    cost : ndarray
+        (N_T, N_C) ground distances.
+    max_iter : int, optional
+        Most iterations of the network simplex.
+    check : bool, optional
+        Check the inputs and repair the duals of zero-weight bins; False skips both, for callers that build valid inputs
+        with positive weights only, like the candidate model.
+
+    Returns
+    -------
+    EmdSolution
+        The flow, its value and the duals; a non-optimal solver exit is reported in it.
+
+    Raises
+    ------
+    ValueError
+        With ``check``, for weights that are negative, not finite or of different totals, or a cost matrix that does
+        not match them or is not finite.
     """
     w_t = np.asarray(w_t, dtype=np.float64)
     w_c = np.asarray(w_c, dtype=np.float64)
@@ -88,5 +168,18 @@ def _check_problem(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray) -> None:
 
 
 def emd_gradient(solution: EmdSolution, dw_c_dy: np.ndarray) -> np.ndarray:
-    """The paper's eq. (10): dD*/dy = sum_v v_v dw_C,v/dy, with dw_c_dy of shape (N_C, 2)."""
+    """The paper's eq. (10): dD*/dy = sum_v v_v dw_C,v/dy.
+
+    Parameters
+    ----------
+    solution : EmdSolution
+        The solved EMD; its candidate duals v are the vector M of eq. (9).
+    dw_c_dy : ndarray
+        (N_C, 2) derivative of the candidate weights.
+
+    Returns
+    -------
+    ndarray
+        (2,) gradient.
+    """
     return solution.v @ dw_c_dy

@@ -25,14 +25,27 @@ _LK = dict(winSize=(11, 11), maxLevel=3)
 
 def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarray | None = None,
                 max_error: float = 2.0) -> np.ndarray | None:
-    """Median motion (dx, dy) in px of the content of ``box`` from ``previous`` into ``current``
-    beyond what ``prior`` predicts, or None when too few points can be followed.
+    """Median motion of the content of ``box`` from ``previous`` into ``current`` beyond what ``prior`` predicts.
 
-    ``previous``, ``current``: HxW uint8 grey frames (frames of different sizes give None); ``box`` =
-    (x, y, w, h) in ``previous``; ``prior``: the 3x3 homography from ``previous`` into ``current`` pixels (the gyro
-    prediction), which seeds the Lucas-Kanade search.  The window's predicted centre plus the
-    returned residual is the flow's starting point.  Only a region around the window and its
-    prediction is processed (one window size of margin), so the cost does not grow with the frame.
+    The window's predicted centre plus the returned residual is the flow's starting point.  Only a region around the
+    window and its prediction is processed (one window size of margin), so the cost does not grow with the frame.
+
+    Parameters
+    ----------
+    previous, current : ndarray
+        HxW uint8 grey frames.
+    box : array_like
+        (x, y, w, h) in ``previous``.
+    prior : ndarray, optional
+        The 3x3 homography from ``previous`` into ``current`` pixels (the gyro prediction), which seeds the
+        Lucas-Kanade search.
+    max_error : float, optional
+        Forward-backward error, px, above which a point is dropped.
+
+    Returns
+    -------
+    ndarray or None
+        (dx, dy) in px; None when too few points can be followed, or for frames of different sizes.
     """
     if previous.shape != current.shape:
         return None

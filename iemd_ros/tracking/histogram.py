@@ -16,9 +16,28 @@ import numpy as np
 
 
 def target_weights(code_weights: np.ndarray, pos: np.ndarray, bandwidth: float) -> np.ndarray:
-    """w_T,u = gamma k(||c_u/h||^2) |p_u|, normalized to sum 1 (eq. sparse target model).
+    """Target histogram w_T,u = gamma k(||c_u/h||^2) |p_u|, normalized to sum 1 (eq. sparse target model).
 
     The candidate weights of the same patches with the kernel at the window centre (y = 0).
+
+    Parameters
+    ----------
+    code_weights : ndarray
+        (N,) pooled code weights p_u.
+    pos : ndarray
+        (N, 2) patch centres, normalized window units.
+    bandwidth : float
+        The kernel's h.
+
+    Returns
+    -------
+    ndarray
+        (N,) weights summing to 1.
+
+    Raises
+    ------
+    ValueError
+        When the histogram is empty (no patch with a non-zero code inside the kernel).
     """
     w, _ = candidate_weights(code_weights, pos, np.zeros(2), bandwidth)
     if not w.any():
@@ -27,14 +46,28 @@ def target_weights(code_weights: np.ndarray, pos: np.ndarray, bandwidth: float) 
 
 
 def candidate_weights(code_weights, pos, y, bandwidth):
-    """w_C,v(y) of eq. (sparse candidate model) and its Jacobian dw_C,v/dy.
+    """Candidate histogram w_C,v(y) of eq. (sparse candidate model) and its Jacobian dw_C,v/dy.
 
-    ``pos`` are the fixed patch centres of the sampled candidate grid and ``y``
-    the kernel centre (2,), both in normalized window units.  Returns (w, dw_dy)
-    with shapes (N,) and (N, 2); w sums to 1 (all zeros if no patch is inside
-    the kernel).  The normalization gamma(y) is differentiated too, so
-    sum_v dw_v/dy = 0 and the gradient does not depend on the arbitrary
-    constant of the duals.
+    The normalization gamma(y) is differentiated too, so sum_v dw_v/dy = 0 and the gradient does not depend on the
+    arbitrary constant of the duals.
+
+    Parameters
+    ----------
+    code_weights : array_like
+        (N,) pooled code weights q_v.
+    pos : array_like
+        (N, 2) fixed patch centres of the sampled candidate grid, normalized window units.
+    y : array_like
+        (2,) kernel centre, normalized window units.
+    bandwidth : float
+        The kernel's h.
+
+    Returns
+    -------
+    w : ndarray
+        (N,) weights summing to 1 (all zeros if no patch is inside the kernel).
+    dw_dy : ndarray
+        (N, 2) their Jacobian.
     """
     return _candidate_weights(np.asarray(code_weights, dtype=np.float64), np.asarray(pos, dtype=np.float64),
                               np.asarray(y, dtype=np.float64), float(bandwidth))
@@ -42,7 +75,7 @@ def candidate_weights(code_weights, pos, y, bandwidth):
 
 @numba.njit(cache=True)
 def _candidate_weights(code_weights, pos, y, bandwidth):
-    """One pass of :func:`candidate_weights` (it runs on every EMD evaluation: 25 -> 2 us)."""
+    """One pass of :func:`candidate_weights` (it runs on every EMD evaluation)."""
     n = pos.shape[0]
     w = np.zeros(n)
     dw_dy = np.zeros((n, 2))

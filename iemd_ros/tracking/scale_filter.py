@@ -20,13 +20,32 @@ from iemd_ros.tracking.correlation_filter import FilterModel, hann, model_size, 
 
 
 class ScaleFilter:
-    """DSST scale filter: ``init`` at the target's window, then per frame ``estimate`` and, when the
-    frame is tracked, ``update``.
+    """DSST scale filter (see the module docstring).
 
-    Windows are (centre, size (w, h), angle) as in :meth:`ImagePyramid.sample`.  ``update`` learns from
-    the sample ``estimate`` took, its desired response centred on the estimated scale (a shift along
-    the scale axis, a phase in the Fourier domain) rather than from a second sample at the new size as
-    DSST does: one sample per frame instead of two.
+    ``init`` at the target's window, then per frame ``estimate`` and, when the frame is tracked, ``update``.  Windows
+    are (centre, size (w, h), angle) as in :meth:`ImagePyramid.sample`.  ``update`` learns from the sample ``estimate``
+    took, its desired response centred on the estimated scale (a shift along the scale axis, a phase in the Fourier
+    domain) rather than from a second sample at the new size as DSST does: one sample per frame instead of two.
+
+    Parameters
+    ----------
+    n_scales : int, optional
+        Number of scales S, odd and >= 3.
+    scale_step : float, optional
+        Ratio of consecutive scales, > 1: the scales are ``scale_step**k`` around the current size.
+    learning_rate : float, optional
+        Rate eta of the filter's running average, in (0, 1].
+    regularization : float, optional
+        Added to the filter's denominator.
+    sigma : float, optional
+        Width of the desired Gaussian response over the scale index, in scale steps (DSST's 33 / sqrt(33) / 4).
+    model_area : int, optional
+        About how many pixels each scaled window is resampled to.
+
+    Raises
+    ------
+    ValueError
+        For an even ``n_scales`` or one below 3, a ``scale_step`` not above 1, or a ``learning_rate`` outside (0, 1].
     """
 
     def __init__(self, n_scales: int = 33, scale_step: float = 1.02, learning_rate: float = 0.025,
@@ -49,16 +68,51 @@ class ScaleFilter:
         self._last = None  # (spectrum, estimated shift in scale steps) of the last estimate
 
     def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
-        """Learn the filter from the window (``center``, ``size``) of the first frame."""
+        """Learn the filter from the window (``center``, ``size``) of the first frame.
+
+        Parameters
+        ----------
+        pyramid : ImagePyramid
+            The first frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+        """
         self.model_size = model_size(size, self.model_area, min_cells=2)
         self._filter.reset()
         self._learn(self._spectrum(pyramid, center, size, angle), 0.0)
         self._last = None
 
     def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0, bounds=None) -> float:
-        """Relative scale of the target in ``pyramid``'s frame against the window ``size`` at ``center``: the
-        factor where the filter response peaks, refined between scales by a parabola through the peak, and
-        limited to ``bounds`` (lowest, highest) if given.  ``update`` learns at the scale returned."""
+        """Relative scale of the target in ``pyramid``'s frame against the window ``size`` at ``center``.
+
+        The factor where the filter response peaks, refined between scales by a parabola through the peak.  ``update``
+        learns at the scale returned.
+
+        Parameters
+        ----------
+        pyramid : ImagePyramid
+            The frame.
+        center, size : array_like
+            The window, as in :meth:`init`.
+        angle : float, optional
+            The window's turn, radians.
+        bounds : tuple of float, optional
+            (lowest, highest) factor the estimate is limited to.
+
+        Returns
+        -------
+        float
+            The relative scale factor.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`init`.
+        """
         if not self._filter.trained:
             raise RuntimeError("ScaleFilter.estimate() called before init()")
         spectrum = self._spectrum(pyramid, center, size, angle)
@@ -73,8 +127,15 @@ class ScaleFilter:
         return float(self.step**shift)
 
     def update(self) -> None:
-        """Blend the last estimate's sample in (the running average of DSST eq. 5), its desired response
-        peaked at the scale it estimated."""
+        """Blend the last estimate's sample in (the running average of DSST eq. 5).
+
+        Its desired response is peaked at the scale it estimated.
+
+        Raises
+        ------
+        RuntimeError
+            Without an :meth:`estimate` since :meth:`init` or the last update.
+        """
         if self._last is None:
             raise RuntimeError("ScaleFilter.update() needs an estimate() first")
         self._learn(*self._last)

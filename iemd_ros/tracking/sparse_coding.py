@@ -127,9 +127,21 @@ def _active_set_lasso(gram, correlations, lam, tol, ridge):
 
 
 class SparseCoder:
-    """Codes patch vectors against a fixed dictionary (Gram matrix cached).
+    """Codes patch vectors against a fixed dictionary by the non-negative lasso of eq. (lagrange), Gram matrix cached.
 
-    ``dictionary`` is (dim, n_atoms) with one vectorized patch per column.
+    Parameters
+    ----------
+    dictionary : ndarray
+        (dim, n_atoms), one vectorized patch per column.
+    lam : float
+        The lambda of eq. (lagrange), > 0.
+    tol : float, optional
+        An atom outside the support enters while half the objective's negative gradient at it exceeds ``tol``.
+
+    Raises
+    ------
+    ValueError
+        For ``lam`` <= 0.
     """
 
     def __init__(self, dictionary: np.ndarray, lam: float, tol: float = 1e-10):
@@ -141,13 +153,41 @@ class SparseCoder:
         self.tol = float(tol)
 
     def encode(self, signals: np.ndarray) -> np.ndarray:
-        """Codes (n_atoms, n_signals) of the columns of ``signals`` (dim, n_signals)."""
+        """Sparse codes of signals.
+
+        Parameters
+        ----------
+        signals : ndarray
+            (dim, n_signals), one signal per column.
+
+        Returns
+        -------
+        ndarray
+            (n_atoms, n_signals) non-negative codes: the exact lasso solutions (the KKT conditions hold to rounding).
+        """
         correlations = np.ascontiguousarray(self.dictionary.T @ np.asarray(signals, dtype=np.float64))
         return _active_set_lasso(self.gram, correlations, self.lam, self.tol, 1e-10)
 
 
 def lasso_objective(dictionary, signals, codes, lam):
-    """Per-signal value of eq. (lagrange)."""
+    """Per-signal value of eq. (lagrange), ||epsilon - Phi a||_2^2 + lambda ||a||_1.
+
+    Parameters
+    ----------
+    dictionary : ndarray
+        (dim, n_atoms) Phi.
+    signals : ndarray
+        (dim, n_signals) epsilon.
+    codes : ndarray
+        (n_atoms, n_signals) a.
+    lam : float
+        The lambda.
+
+    Returns
+    -------
+    ndarray
+        (n_signals,) objective values.
+    """
     residual = signals - dictionary @ codes
     return (residual**2).sum(axis=0) + lam * np.abs(codes).sum(axis=0)
 
@@ -155,9 +195,23 @@ def lasso_objective(dictionary, signals, codes, lam):
 def max_alignment_pooling(codes: np.ndarray, n_templates: int) -> np.ndarray:
     """Bin weights ``||a_bar_r||_inf`` with ``a_bar_j = sum_i a_ij`` (section 4).
 
-    ``codes`` is (n_templates * n_positions, n_patches), atoms ordered template
-    by template with the same patch positions in each, as the dictionary is
-    built.  Returns one non-negative weight per patch.
+    Parameters
+    ----------
+    codes : ndarray
+        (n_templates * n_positions, n_patches), atoms ordered template by template with the same patch positions in
+        each, as the dictionary is built.
+    n_templates : int
+        Number of templates in the dictionary.
+
+    Returns
+    -------
+    ndarray
+        (n_patches,) non-negative weights, one per patch.
+
+    Raises
+    ------
+    ValueError
+        When the atoms are not ``n_templates`` templates of equal size.
     """
     n_atoms, n_patches = codes.shape
     if n_atoms % n_templates:

@@ -10,10 +10,22 @@ from iemd_ros.tracking.sparse_coding import SparseCoder, max_alignment_pooling
 class TemplateDictionary:
     """Dictionary Phi of local patches from up to L templates (section 4).
 
-    The first L tracked templates fill the dictionary; afterwards only the latest
-    one is replaced (Algorithm 2).  Atoms are ordered template by template, each
-    template contributing the patches of ``layout`` in the same order, which is
+    The first L tracked templates fill the dictionary; afterwards only the latest one is replaced (Algorithm 2).  Atoms
+    are ordered template by template, each template contributing the patches of ``layout`` in the same order, which is
     what max-alignment pooling needs.
+
+    Parameters
+    ----------
+    layout : PatchLayout
+        The patches of a template.
+    n_templates : int
+        The number L of templates.
+    lam : float
+        The lambda of the patches' sparse coding (eq. lagrange).
+    forgetting : float
+        The decay gamma0 of the latest template's weight (eq. template update).
+    reconstruction_lambda : float
+        The lambda of the reconstructed template (eq. reconstructed template).
     """
 
     def __init__(self, layout: PatchLayout, n_templates: int, lam: float,
@@ -33,32 +45,66 @@ class TemplateDictionary:
         self.coder = SparseCoder(atoms, self.lam)
 
     def add(self, template: np.ndarray, emd: float, index: int) -> None:
-        """Append a template while the dictionary holds fewer than L."""
+        """Append a template while the dictionary holds fewer than L.
+
+        Parameters
+        ----------
+        template : ndarray
+            (Th, Tw) tracked template.
+        emd : float
+            Its EMD D*; its weight is omega = exp(-emd).
+        index : int
+            Frame index k at which it enters.
+        """
         self.templates.append(np.asarray(template, dtype=np.float64))
         self.latest_weight, self.latest_index = float(np.exp(-emd)), index
         self._rebuild()
 
     def code_weights(self, eps: np.ndarray) -> np.ndarray:
-        """Pooled bin weights ||a-bar||_inf of patches ``eps`` (N, d): their sparse codes over Phi
-        (eq. lagrange) with max-alignment pooling over the L templates (section 4)."""
+        """Pooled bin weights ||a-bar||_inf of patches.
+
+        Their sparse codes over Phi (eq. lagrange) with max-alignment pooling over the L templates (section 4).
+
+        Parameters
+        ----------
+        eps : ndarray
+            (N, d) appearance vectors of the patches.
+
+        Returns
+        -------
+        ndarray
+            (N,) weights.
+        """
         return max_alignment_pooling(self.coder.encode(eps.T), len(self.templates))
 
     @property
     def full(self) -> bool:
+        """Whether the dictionary holds L templates."""
         return len(self.templates) >= self.n_templates
 
     def observe(self, template: np.ndarray, emd: float, index: int) -> bool:
-        """Algorithm 2 for the tracked template I_k with EMD D*_k; True if Phi changed.
+        """Algorithm 2 for the tracked template I_k with EMD D*_k.
 
-        The latest template's weight decays as omega_{i-1} = gamma0^{Delta i} omega
-        (eq. template update) and the current one has omega_i = exp(-D*_k).
-        Reading of the comparison: the paper's text and pseudo-code replace when
-        omega_i < omega_{i-1}, which would insert templates that match *worse*
-        (drifting into occluders and background).  We replace when the current
-        template is the better-weighted one, omega_i > gamma0^{Delta i} omega_{i-1},
-        i.e. D*_k < D*_last + Delta i |ln gamma0|: confident templates refresh the
-        dictionary, and a stale one is refreshed more readily as it ages.
-        The first L-1 templates are never replaced, which anchors the appearance.
+        The latest template's weight decays as omega_{i-1} = gamma0^{Delta i} omega (eq. template update) and the
+        current one has omega_i = exp(-D*_k).  Reading of the comparison: the paper's text and pseudo-code replace when
+        omega_i < omega_{i-1}, which would insert templates that match *worse* (drifting into occluders and background).
+        We replace when the current template is the better-weighted one, omega_i > gamma0^{Delta i} omega_{i-1}, i.e.
+        D*_k < D*_last + Delta i |ln gamma0|: confident templates refresh the dictionary, and a stale one is refreshed
+        more readily as it ages.  The first L-1 templates are never replaced, which anchors the appearance.
+
+        Parameters
+        ----------
+        template : ndarray
+            (Th, Tw) tracked template I_k.
+        emd : float
+            Its EMD D*_k.
+        index : int
+            Frame index k.
+
+        Returns
+        -------
+        bool
+            True if Phi changed.
         """
         if not self.full:
             # Filling the first L slots: the tracked templates themselves (a
@@ -77,17 +123,23 @@ class TemplateDictionary:
     def reconstruct(self, template: np.ndarray) -> np.ndarray:
         """Reconstructed template of eq. (reconstructed template), occluders removed.
 
-        Solves min ||I_k - [Phi_T I] a||^2 + lambda ||a||_1 with a >= 0 on the
-        template part and a free sign on the trivial (identity) part, by block
-        coordinate descent: the trivial part e has the closed form of soft
-        thresholding the residual at lambda/2, the template part is a small
-        non-negative lasso over the L whole templates.
-        Returned: I_k - e, i.e. the observed template where the trivial templates
-        claim nothing and Phi_T a* (+- lambda/2) where they do (occluders, noise).
-        The paper keeps Phi_T a* alone; but that only recombines the templates
-        already in the dictionary, so the dictionary could never take in a new
-        appearance (lighting, pose).  Keeping the unclaimed observed pixels does,
-        while an occluder is still replaced by what the dictionary predicts.
+        Solves min ||I_k - [Phi_T I] a||^2 + lambda ||a||_1 with a >= 0 on the template part and a free sign on the
+        trivial (identity) part, by block coordinate descent: the trivial part e has the closed form of soft
+        thresholding the residual at lambda/2, the template part is a small non-negative lasso over the L whole
+        templates.  The paper keeps Phi_T a* alone; but that only recombines the templates already in the dictionary, so
+        the dictionary could never take in a new appearance (lighting, pose).  Keeping the unclaimed observed pixels
+        does, while an occluder is still replaced by what the dictionary predicts.
+
+        Parameters
+        ----------
+        template : ndarray
+            (Th, Tw) observed template I_k.
+
+        Returns
+        -------
+        ndarray
+            I_k - e, of the template's shape: the observed template where the trivial templates claim nothing and
+            Phi_T a* (+- lambda/2) where they do (occluders, noise).
         """
         x = np.asarray(template, dtype=np.float64).ravel()
         phi_t = np.column_stack([t.ravel() for t in self.templates])

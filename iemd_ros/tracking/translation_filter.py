@@ -21,10 +21,29 @@ from iemd_ros.tracking.correlation_filter import CELL, FilterModel, hann, model_
 
 
 class TranslationFilter:
-    """``init`` at the target's window, per frame ``estimate`` at the predicted window (then
-    ``response_at`` for candidate centres) and, when the frame is tracked, ``update`` at the tracked window.
+    """DSST's translation filter (see the module docstring).
 
-    Windows are (centre, size (w, h), angle) as in :meth:`ImagePyramid.sample`.
+    ``init`` at the target's window, per frame ``estimate`` at the predicted window (then ``response_at`` for candidate
+    centres) and, when the frame is tracked, ``update`` at the tracked window.  Windows are (centre, size (w, h), angle)
+    as in :meth:`ImagePyramid.sample`.
+
+    Parameters
+    ----------
+    padding : float, optional
+        The search region is the window's size times 1 + ``padding`` on each axis; >= 0.
+    learning_rate : float, optional
+        Rate of the filter's running average, in (0, 1].
+    regularization : float, optional
+        Added to the filter's denominator.
+    sigma_factor : float, optional
+        Width of the desired Gaussian response, times the target's size in cells.
+    model_area : int, optional
+        About how many pixels the search region is resampled to.
+
+    Raises
+    ------
+    ValueError
+        For a negative ``padding`` or a ``learning_rate`` outside (0, 1].
     """
 
     def __init__(self, padding: float = 1.5, learning_rate: float = 0.025, regularization: float = 0.01,
@@ -39,7 +58,19 @@ class TranslationFilter:
         self._response = None  # (response map, centre, cell size in image px, angle) of the last estimate
 
     def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
-        """Learn the filter from the window (``center``, ``size``) of the first frame."""
+        """Learn the filter from the window (``center``, ``size``) of the first frame.
+
+        Parameters
+        ----------
+        pyramid : ImagePyramid
+            The frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+        """
         self.model_size = model_size(self._region(size), self.model_area, min_cells=4)
         cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
         self._taper = np.outer(hann(rows), hann(cols))[..., None]
@@ -52,8 +83,31 @@ class TranslationFilter:
         self._response = None
 
     def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> np.ndarray:
-        """Displacement (dx, dy), image pixels, from ``center`` to where the response peaks in the region around
-        the window (``center``, ``size``), refined between cells by a parabola through the peak."""
+        """Displacement to where the response peaks in the region around the window (``center``, ``size``).
+
+        The peak is refined between cells by a parabola through it; the response map is kept for :meth:`response_at`.
+
+        Parameters
+        ----------
+        pyramid : ImagePyramid
+            The frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+
+        Returns
+        -------
+        ndarray
+            (dx, dy), image pixels, from ``center``.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`init`.
+        """
         if not self._filter.trained:
             raise RuntimeError("TranslationFilter.estimate() called before init()")
         response = np.fft.ifft2(self._filter.response(self._spectrum(pyramid, center, size, angle))).real
@@ -68,7 +122,23 @@ class TranslationFilter:
         return window_axes(angle) @ (cells * cell_px)
 
     def response_at(self, point) -> float:
-        """The last estimate's response at image point ``point`` (bilinear between cells; 0 outside the region)."""
+        """The last estimate's response at an image point.
+
+        Parameters
+        ----------
+        point : array_like
+            (x, y) image point.
+
+        Returns
+        -------
+        float
+            The response, bilinear between cells; 0 outside the region.
+
+        Raises
+        ------
+        RuntimeError
+            Before an :meth:`estimate`.
+        """
         if self._response is None:
             raise RuntimeError("TranslationFilter.response_at() needs an estimate() first")
         response, center, cell_px, angle = self._response
@@ -83,7 +153,19 @@ class TranslationFilter:
         return float(value)
 
     def update(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
-        """Blend in a sample at the tracked window (the running average of DSST eq. 5)."""
+        """Blend in a sample at the tracked window (the running average of DSST eq. 5).
+
+        Parameters
+        ----------
+        pyramid : ImagePyramid
+            The frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+        """
         self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
 
     def _region(self, size) -> np.ndarray:

@@ -3,4 +3,11 @@ from iemd_ros.tracking.config import TrackerConfig
 
 
 def parameters() -> TrackerConfig:
+    """The shipped tracker's configuration.
+
+    Returns
+    -------
+    TrackerConfig
+        ``TrackerConfig()``: the defaults.
+    """
     return TrackerConfig()

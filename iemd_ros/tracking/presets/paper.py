@@ -4,6 +4,13 @@ from iemd_ros.tracking.config import Gradient, ScaleEstimator, TrackerConfig
 
 
 def parameters() -> TrackerConfig:
+    """The configuration of the paper's system (see the module docstring).
+
+    Returns
+    -------
+    TrackerConfig
+        The paper's gradient, EMD scale variants and particles; no discriminative extension.
+    """
     return TrackerConfig(
         gradient=Gradient.PAPER,
         scale_estimator=ScaleEstimator.EMD,
