@@ -7,8 +7,9 @@ alike).  Only ``update`` calls are timed.  A tracker that has lost the target ma
 skips its model update on a failed frame), so the number of frames each tracker reported failed is shown.  Prints median / p95 update time (ms) and fps per tracker, and
 the fps ratio of each tracker against the reference (CSRT by default) per sequence and pooled.
 
-Sequences: a few OTB sequences (init on their first GT box) plus the 640x480 CMU desk frames
-(``../shared/data/imu/cmu_hwangbo_desk``, init on the first box of ``gt_eagle_head.txt``).
+Sequences: a few OTB sequences and 1280x720 drone sequences (init on their first GT box) plus the 640x480 CMU desk
+frames (``../shared/data/imu/cmu_hwangbo_desk``, init on the first box of ``gt_eagle_head.txt``).  Besides each
+sequence, the frames are pooled by class: up to 640x480 pixels, and larger (the 1280x720 drone frames).
 
     PYTHONPATH=. .venv/bin/python benchmarks/bench_speed.py [--trackers iemd,csrt] [--frames 150]
 """
@@ -22,7 +23,7 @@ import numpy as np
 
 from iemd_ros.common.cli import CliParser, cli_main
 from iemd_ros.evaluation.ope import TRACKERS, make_tracker, run_tracker
-from iemd_ros.datasets.otb import default_root, list_sequences, load_sequence
+from iemd_ros.datasets.otb import default_roots, list_sequences, load_sequence
 from iemd_ros.datasets.recordings import load_recording
 
 DESK = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "imu" / "cmu_hwangbo_desk"
@@ -34,8 +35,8 @@ def desk_sequence(n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
     return "desk-640x480", [rec.load_frame(i) for i in range(min(n, len(rec)))], rec.gt_boxes[0]
 
 
-def otb_sequence(name: str, root: Path, n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
-    seq = load_sequence(name, root).head(n)
+def otb_sequence(name: str, n: int) -> tuple[str, list[np.ndarray], np.ndarray]:
+    seq = load_sequence(name).head(n)
     frames = list(seq.frames())
     return f"{name}-{'x'.join(map(str, frames[0].shape[1::-1]))}", frames, seq.gt_boxes[0]
 
@@ -48,7 +49,8 @@ def _main(argv) -> int:
     p = CliParser(prog="bench_speed", description=__doc__.split("\n\n")[0])
     p.add_argument("--trackers", default="iemd,csrt", help=f"comma-separated from {','.join(TRACKERS)}")
     p.add_argument("--reference", default="csrt", help="tracker the fps ratios are taken against")
-    p.add_argument("--sequences", default="Car4,Bolt2,Woman,DragonBaby", help="OTB sequences")
+    p.add_argument("--sequences", default="Car4,Bolt2,Woman,DragonBaby,boat5,truck2,wakeboard10,building5",
+                   help="sequences of ../shared/data/otb and ../shared/data/uav")
     p.add_argument("--frames", type=int, default=150)
     p.add_argument("--no-desk", action="store_true", help="skip the 640x480 CMU desk frames")
     p.add_argument("--cv-threads", type=int, default=None,
@@ -61,34 +63,41 @@ def _main(argv) -> int:
         make_tracker(t)
     if args.reference not in trackers:
         raise ValueError(f"--reference {args.reference!r} is not among --trackers {trackers}")
-    root = default_root()
-    if root is None:
-        raise ValueError("../shared/data/otb not found")
+    roots = default_roots()
+    if not roots:
+        raise ValueError("../shared/data/otb and ../shared/data/uav not found")
     names = [n for n in args.sequences.split(",") if n]
-    unknown = sorted(set(names) - set(list_sequences(root)))
+    unknown = sorted(set(names) - {s for root in roots for s in list_sequences(root)})
     if unknown:
-        raise ValueError(f"unknown OTB sequence(s) {', '.join(unknown)} in {root}")
-    loaders = [lambda n=n: otb_sequence(n, root, args.frames) for n in names]
+        raise ValueError(f"unknown sequence(s) {', '.join(unknown)} in {', '.join(map(str, roots))}")
+    loaders = [lambda n=n: otb_sequence(n, args.frames) for n in names]
     if not args.no_desk and DESK.is_dir():
         loaders.append(lambda: desk_sequence(args.frames))
 
     if args.cv_threads is not None:
         cv2.setNumThreads(args.cv_threads)
-    pooled: dict[str, list[np.ndarray]] = {t: [] for t in trackers}
-    failed: dict[str, int] = {t: 0 for t in trackers}
+    pooled: dict[str, dict[str, list[np.ndarray]]] = {c: {t: [] for t in trackers} for c in CLASSES}
+    failed: dict[str, dict[str, int]] = {c: {t: 0 for t in trackers} for c in CLASSES}
     print(f"OpenCV {cv2.__version__}, cv2.getNumThreads() = {cv2.getNumThreads()}; {args.frames} frames/sequence")
     print(f"{'sequence':<22} {'tracker':<6} {'median ms':>10} {'p95 ms':>8} {'fps':>8} {'ratio':>7} {'failed':>7}")
     for load in loaders:
         name, frames, box = load()
+        kind = CLASSES[0] if frames[0].shape[0] * frames[0].shape[1] <= 640 * 480 else CLASSES[1]
         ms, fails = {}, {}
         for t in trackers:
             run = run_tracker(make_tracker(t), frames, box)
             ms[t], fails[t] = 1e3 * run.update_seconds, int((~run.ok).sum())
-            pooled[t].append(ms[t])
-            failed[t] += fails[t]
+            pooled[kind][t].append(ms[t])
+            failed[kind][t] += fails[t]
         _report(name, ms, fails, args.reference)
-    _report("ALL (pooled)", {t: np.concatenate(v) for t, v in pooled.items()}, failed, args.reference)
+    for kind in CLASSES:
+        if pooled[kind][args.reference]:
+            _report(f"{kind} (pooled)", {t: np.concatenate(v) for t, v in pooled[kind].items()}, failed[kind],
+                    args.reference)
     return 0
+
+
+CLASSES = ("<= 640x480", "1280x720")  # frame classes pooled: up to VGA's area, and larger
 
 
 def _report(name: str, ms: dict[str, np.ndarray], fails: dict[str, int], reference: str) -> None:

@@ -17,7 +17,7 @@ import cv2
 
 from iemd_ros.evaluation.ope import OpenCVTracker, run_tracker, sequence_names
 from iemd_ros.evaluation.metrics import score_sequence
-from iemd_ros.datasets.otb import default_root, load_sequence
+from iemd_ros.datasets.otb import load_sequence
 
 VARIANTS = {
     "defaults": {},
@@ -40,7 +40,7 @@ def create(fields: dict) -> "cv2.Tracker":
 
 def run(name: str) -> list[float]:
     """Average overlap (%) of every variant on sequence ``name``."""
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     frames = list(seq.frames())
     overlaps = []
     for fields in VARIANTS.values():

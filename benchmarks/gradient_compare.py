@@ -23,7 +23,7 @@ import numpy as np
 
 from iemd_ros import IemdTracker
 from iemd_ros.common.boxes import box_centre, centre_box
-from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.analysis import descend
 
 GRADIENTS = ("paper", "appearance")
@@ -46,7 +46,7 @@ def main():
     errors = {(case, g): [] for case in CASES for g in GRADIENTS}
     iterations = {key: [] for key in errors}
     for name in args.sequences.split(","):
-        seq = load_sequence(name, default_root())
+        seq = load_sequence(name)
         for k in np.linspace(5, len(seq) - 1, 6).astype(int):
             prev = read_frame(seq.frame_paths[k - 1])
             tracker = IemdTracker()

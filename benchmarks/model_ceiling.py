@@ -30,7 +30,7 @@ from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.tracking.candidate import CandidateModel
 from iemd_ros.evaluation.metrics import iou
 from iemd_ros.evaluation.ope import sequence_names
-from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.analysis import descend, search_context
 
 OFFSETS = np.linspace(-0.6, 0.6, 13)
@@ -54,7 +54,7 @@ def _grid_argmin_iou(score, truth) -> float:
 
 def measure(job):
     name, stride, jump = job
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     first = read_frame(seq.frame_paths[0])
     tracker = IemdTracker()  # descend() and search_context() leave the frame-1 model as it is
     tracker.init(first, seq.gt_boxes[0])
@@ -83,7 +83,7 @@ def measure(job):
 
 def capture(name):
     """Per start distance in CAPTURE_STARTS, the share of searches that end within 0.05 window sizes."""
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     converged, searches = np.zeros(len(CAPTURE_STARTS)), 0
     for k in np.linspace(0, len(seq) - 1, 6).astype(int):
         frame, truth = read_frame(seq.frame_paths[k]), np.asarray(seq.gt_boxes[k], dtype=float)

@@ -26,7 +26,7 @@ from iemd_ros import TrackerConfig
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.metrics import score_sequence
-from iemd_ros.datasets.otb import default_root, load_sequence
+from iemd_ros.datasets.otb import load_sequence
 
 # Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, and the box's scale.
 DIAGONALS = ((0.0, 0.0, 1.0), (1.0, 1.0, 1.0), (-1.0, 1.0, 1.0), (1.0, -1.0, 1.0), (-1.0, -1.0, 1.0))
@@ -44,7 +44,7 @@ def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: floa
 def run(job):
     """[(average overlap, median update ms) per start] of each run on one sequence, decoded once."""
     name, runs, shift, starts = job
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     frames = list(seq.frames())
     first = np.asarray(seq.gt_boxes[0], dtype=float)
     out = []

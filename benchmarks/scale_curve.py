@@ -32,7 +32,7 @@ from iemd_ros.tracking.appearance import ImagePyramid, to_gray
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking.candidate import CandidateModel
 from iemd_ros.evaluation.ope import sequence_names
-from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.analysis import search_context
 
 SCALES = np.exp(np.linspace(np.log(0.8), np.log(1.25), 23))  # 2.0 % apart; SCALES[11] = 1
@@ -42,7 +42,7 @@ SHOWN = (0, 4, 8, 10, 12, 14, 18, 22)  # 0.80, 0.87, 0.94, 0.98, 1.02, 1.06, 1.1
 def curve(job):
     """Per scored frame, the EMD and the negative NCC at each of SCALES: (frames, 2, len(SCALES))."""
     name, stride = job
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     tracker = IemdTracker(TrackerConfig(update_templates=False))
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     reference = tracker.dictionary.templates[0].ravel()
@@ -63,7 +63,7 @@ def oracle_translation(job):
     """Mean |log(size / ground-truth size)| of the tracker whose window a translation prior moves to the
     ground-truth centre before each update (the public API: no private state is set)."""
     name, config = job
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     tracker = IemdTracker(TrackerConfig.from_dict(dict(n_iter=0, flow_start=False, **config)))
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     errors = []

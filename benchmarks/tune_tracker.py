@@ -24,13 +24,13 @@ from iemd_ros.tracking.appearance import ImagePyramid, to_gray
 from iemd_ros.evaluation.ope import evaluate_sequence, make_tracker
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking.candidate import CandidateModel
-from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.analysis import search_context
 
 
 def overlap(job):
     name, config, frames = job
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     if frames:
         seq = seq.head(frames)
     scores, run = evaluate_sequence(seq, make_tracker("iemd", config))
@@ -39,7 +39,7 @@ def overlap(job):
 
 def discrimination(job, radius=40, grid=4):
     name, config, _ = job
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     tracker = IemdTracker(config)
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     picks = np.linspace(10, len(seq) - 1, 5).astype(int)

@@ -39,7 +39,7 @@ from iemd_ros.tracking.candidate import CandidateModel
 from iemd_ros.tracking.emd import ground_distance, solve_emd
 from iemd_ros.tracking.histogram import candidate_weights
 from iemd_ros.evaluation.ope import sequence_names
-from iemd_ros.datasets.otb import default_root, load_sequence, read_frame
+from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.analysis import search_context
 from model_ceiling import grid_argmin  # benchmarks/ is the script's directory
 
@@ -88,7 +88,7 @@ class VoteHistogram:
 
 def measure(job):
     name, frames, stride = job
-    seq = load_sequence(name, default_root())
+    seq = load_sequence(name)
     tracker = IemdTracker()
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     votes = VoteHistogram(tracker)

@@ -162,3 +162,54 @@ def test_sequence_names_selects_from_the_shared_otb_root(otb_root):
     assert sequence_names("") == everything and {"Car4", "Woman", "Jogging-1"} <= set(everything)
     with pytest.raises(ValueError, match="unknown sequence 'Nope'"):
         sequence_names("Nope")
+
+
+def test_group_means_and_published_ranking(tmp_path, monkeypatch, capsys):
+    """Sequences from two folders get a mean each and one over all; --published ranks the run among the file's
+    trackers on the sequences both have, per set."""
+    root_a, gt = _synthetic_root(tmp_path / "a")
+    root_b, _ = _synthetic_root(tmp_path / "b")
+    (root_b / "Toy").rename(root_b / "Toy2")
+    root_b = root_b.rename(root_b.with_name("other"))
+    _Oracle.gt = gt
+    monkeypatch.setitem(evaluation.TRACKERS, "oracle", _Oracle)
+    published = {"setA": {"Good": {"Toy": {"avg_overlap": 90.0, "auc": 88.0}},
+                          "LADCF": {"Toy": {"avg_overlap": 99.0, "auc": 98.0}},
+                          "Partial": {"Other": {"avg_overlap": 50.0, "auc": 50.0}}}}
+    path = tmp_path / "published.json"
+    path.write_text(json.dumps(published))
+    out = tmp_path / "out"
+    assert main([str(root_a), str(root_b), "--trackers", "oracle", "--out", str(out), "--max-frames", "5",
+                 "--published", str(path)]) == 0
+    doc = json.loads((out / "results.json").read_text())
+    means = {k for k in doc["results"]["oracle"] if k.startswith("mean")}
+    assert means == {"mean", "mean data", "mean other"} and doc["groups"] == {"Toy": "data", "Toy2": "other"}
+    assert doc["results"]["oracle"]["mean data"]["n_sequences"] == 1 == doc["results"]["oracle"]["mean other"]["n_sequences"]
+    text = capsys.readouterr().out
+    lines = text[text.index("published results, set setA"):].splitlines()
+    assert "1 sequence(s) of this run (Toy)" in lines[0]
+    order = [line.split()[0] for line in lines[2:5]]
+    assert order == ["oracle", "LADCF", "Good"] and "deep" in lines[3] and "hand-crafted" in lines[4]
+    assert "Partial" not in text and "first 5 frames only" in text
+
+
+def test_published_file_errors(tmp_path, capsys):
+    bad = tmp_path / "bad.json"
+    bad.write_text("[1, 2]")
+    assert "expected {set: {tracker:" in cli_error(main, ["--published", str(bad), "--trackers", "kcf"], capsys,
+                                                   "iemd-eval: error:")
+
+
+def test_the_split_is_the_hash_rule_over_the_shared_sequences(otb_root):
+    from iemd_ros.datasets.otb import list_sequences
+    from iemd_ros.evaluation.split import hash_split, split, split_names
+
+    for group in ("otb", "uav"):
+        folder = otb_root.parent / group
+        if not folder.is_dir():
+            pytest.skip(f"{folder} is absent")
+        train, validation = hash_split(list_sequences(folder))
+        assert (train, validation) == (split()["train"][group], split()["validation"][group])
+    assert not set(split_names("train")) & set(split_names("validation"))
+    with pytest.raises(ValueError, match="unknown split part 'test'"):
+        split_names("test")

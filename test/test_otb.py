@@ -154,3 +154,23 @@ def test_real_david_woman_jogging(otb_root):
     j1, j2 = (load_sequence(n, otb_root) for n in jog)
     assert j1.frame_paths == j2.frame_paths
     assert not np.allclose(j1.gt_boxes[0], j2.gt_boxes[0])  # two different targets
+
+
+@pytest.mark.parametrize("pattern", ["{:05d}.jpg", "{:06d}.jpg", "img{:06d}.jpg", "frame_{:d}.png"])
+def test_image_names_ending_in_the_frame_number(tmp_path, pattern):
+    """UAV123's 000001.jpg, DTB70's 00001.jpg, UAVDT's img000001.jpg: the number that ends the name orders them."""
+    (tmp_path / "S" / "img").mkdir(parents=True)
+    for k, n in enumerate([10, 9, 11]):
+        cv2.imwrite(str(tmp_path / "S" / "img" / pattern.format(n)), np.full((8, 8, 3), 10 * k, np.uint8))
+    (tmp_path / "S" / "groundtruth_rect.txt").write_text("1,1,4,4\n2,2,4,4\n3,3,4,4\n")
+    seq = load_sequence(tmp_path / "S")
+    assert seq.frame_numbers == (9, 10, 11) and seq.group == tmp_path.name
+    (tmp_path / "S" / "img" / "cover.jpg").write_bytes(b"x")
+    with pytest.raises(ValueError, match="must end in their frame number, got 'cover.jpg'"):
+        load_sequence(tmp_path / "S")
+
+
+def test_nan_annotation_lines_are_absent_frames(tmp_path):
+    seq_dir = _make_seq(tmp_path / "A", [1, 2, 3], {"groundtruth_rect.txt": "1,1,5,5\nNaN,NaN,NaN,NaN\n3,3,5,5\n"})
+    boxes = load_sequence(seq_dir).gt_boxes
+    assert np.isnan(boxes[1]).all() and not np.isnan(boxes[[0, 2]]).any()

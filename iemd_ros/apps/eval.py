@@ -1,11 +1,14 @@
 """``iemd-eval``: one-pass evaluation of trackers on OTB-layout sequences (:mod:`iemd_ros.evaluation.ope`).
 
-    iemd-eval [ROOT_OR_SEQ ...] [--trackers iemd,csrt,kcf] [--sequences Car4,Bolt2] [--max-frames N] [--out DIR]
-              [--config config/tracker.yaml]
+    iemd-eval [ROOT_OR_SEQ ...] [--trackers iemd,csrt,kcf] [--sequences Car4,Bolt2] [--split train|validation]
+              [--max-frames N] [--out DIR] [--config config/tracker.yaml] [--published [FILE]]
 
-Prints the average overlap, success AUC, precision at 20 px and fps per sequence and on average, and writes
+Without a folder it evaluates every sequence of ``../shared/data/otb`` and ``../shared/data/uav``.  Prints the
+average overlap, success AUC, precision at 20 px and fps per sequence and on average, and writes
 ``results.json`` and one success plot per sequence plus an overall one into ``--out``.  Bad input prints one line
-on stderr and exits with status 2.
+on stderr and exits with status 2.  ``--split`` keeps the training or the validation part of the fixed split
+(:mod:`iemd_ros.evaluation.split`); ``--published`` ranks the run among the published trackers on the same sequences
+(:mod:`iemd_ros.evaluation.published`).
 """
 from __future__ import annotations
 
@@ -17,7 +20,11 @@ from pathlib import Path
 from iemd_ros.common.cli import CliParser, cli_main
 from iemd_ros.evaluation.ope import (DEFAULT_OUT, DEFAULT_TRACKERS, TRACKERS, collect_sequences, evaluate,
                                      format_table, make_tracker)
+from iemd_ros.evaluation.published import default_published, format_published, load_published
+from iemd_ros.evaluation.split import PARTS, split_names
 from iemd_ros.pipeline import PipelineConfig
+
+PUBLISHED_DEFAULT = Path("<default>")  # --published without a file
 
 __all__ = ["main", "build_parser"]
 
@@ -43,16 +50,22 @@ def build_parser() -> argparse.ArgumentParser:
     p = CliParser(prog="iemd-eval", description=__doc__.split("\n\n")[0],
                   formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("inputs", nargs="*", metavar="ROOT_OR_SEQ",
-                   help="OTB root folder(s) and/or sequence folder(s); default ../shared/data/otb")
+                   help="folder(s) of OTB-layout sequences and/or sequence folder(s); default ../shared/data/otb "
+                        "and ../shared/data/uav")
     p.add_argument("--trackers", type=_csv, default=list(DEFAULT_TRACKERS),
                    help=f"comma-separated, from {','.join(TRACKERS)} (default: all)")
     p.add_argument("--sequences", type=_csv, default=None,
                    help="comma-separated sequence names (Jogging selects Jogging-1 and Jogging-2)")
+    p.add_argument("--split", choices=PARTS, default=None,
+                   help="only the sequences of this part of the fixed split (iemd_ros/evaluation/split.json)")
     p.add_argument("--max-frames", type=_positive_int, default=None, help="evaluate only the first N frames")
     p.add_argument("--out", type=Path, default=DEFAULT_OUT, help="output folder (default out/eval)")
     p.add_argument("--config", type=Path, default=None,
                    help="iEMD parameters: the node's parameter file (config/tracker.yaml) or {tracker: {...}}; "
                         "its tracker.* values apply (OTB has no IMU)")
+    p.add_argument("--published", nargs="?", type=Path, const=PUBLISHED_DEFAULT, default=None, metavar="FILE",
+                   help="print the published trackers' results on the same sequences beside the run "
+                        "(default file: ../shared/anchors/published_results.json)")
     return p
 
 
@@ -65,7 +78,19 @@ def main(argv: list[str] | None = None) -> int:
         if args.config and "iemd" not in trackers:
             raise ValueError("--config sets the iemd tracker's parameters, but iemd is not among --trackers")
         configs = {"iemd": PipelineConfig.from_yaml(args.config).tracker} if args.config else {}
-        sequences = collect_sequences(args.inputs, args.sequences)
+        published = None
+        if args.published is not None:
+            path = default_published() if args.published == PUBLISHED_DEFAULT else args.published
+            if path is None:
+                raise ValueError("--published: ../shared/anchors/published_results.json does not exist; give the file")
+            published = load_published(path)
+        wanted = args.sequences
+        if args.split is not None:
+            part = split_names(args.split)
+            wanted = part if wanted is None else [w for w in wanted if w in part]
+            if not wanted:
+                raise ValueError(f"--sequences names none of the {args.split} part's sequences")
+        sequences = collect_sequences(args.inputs, wanted)
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
         t_start = time.perf_counter()
@@ -74,6 +99,12 @@ def main(argv: list[str] | None = None) -> int:
         doc = evaluate(sequences, trackers, args.out, configs=configs)  # unreadable image, unwritable --out: one line, exit 2
         print()
         print(format_table(doc["results"], trackers, doc["sequences"]))
+        if published is not None:
+            print()
+            print(format_published(published, doc["results"], trackers))
+            if args.max_frames is not None:
+                print(f"(this run scored the first {args.max_frames} frames only; the published figures are over "
+                      "whole sequences)")
         print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}")
         return 0
 

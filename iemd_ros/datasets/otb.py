@@ -1,8 +1,10 @@
 """Loading of OTB-layout sequences (Wu, Lim & Yang 2013), the benchmark of the paper's evaluation.
 
-Layout: ``<root>/<Seq>/img/NNNN.jpg`` and ``<root>/<Seq>/groundtruth_rect.txt``.  GT lines are
+Layout: ``<root>/<Seq>/img/<frame number>.jpg`` (``0001.jpg``, ``000001.jpg``, ``img000001.jpg``: the number ends the
+name) and ``<root>/<Seq>/groundtruth_rect.txt``.  GT lines are
 ``x, y, w, h`` with 1-based pixel coordinates, separated by commas, tabs or spaces (CRLF and a missing
-final newline occur); blank lines are ignored.  Boxes are returned 0-based (``x - 1, y - 1``).
+final newline occur); blank lines are ignored; a line of ``NaN`` values marks a frame where the target is absent.
+Boxes are returned 0-based (``x - 1, y - 1``).
 
 * Line *i* of the GT belongs to the *i*-th image in frame-number order; frame numbers come from the
   file names (David starts at 0300, as in the OTB toolkit's ``configSeqs``).
@@ -24,6 +26,7 @@ GT_NAME = "groundtruth_rect.txt"
 _MULTI_GT = re.compile(r"^groundtruth_rect\.(\d+)\.txt$")
 _TARGET_NAME = re.compile(r"^(.+)-(\d+)$")
 _SPLIT = re.compile(r"[,\s]+")
+_FRAME_NUMBER = re.compile(r"(\d+)$")  # the digits that end an image's name
 IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
 
 
@@ -41,12 +44,15 @@ class Sequence:
         (N, 4) GT boxes, all NaN where the target is absent.
     frame_numbers : tuple of int, optional
         Frame numbers, from the file names.
+    group : str, optional
+        The folder of sequences it comes from (``otb``, ``uav``): means are taken per group.
     """
 
     name: str
     frame_paths: tuple[Path, ...]
     gt_boxes: np.ndarray
     frame_numbers: tuple[int, ...] = ()
+    group: str = ""
 
     def __len__(self) -> int:
         return len(self.frame_paths)
@@ -71,7 +77,7 @@ class Sequence:
         """
         if n < 1:
             raise ValueError(f"{self.name}: number of frames must be >= 1, got {n}")
-        return Sequence(self.name, self.frame_paths[:n], self.gt_boxes[:n], self.frame_numbers[:n])
+        return Sequence(self.name, self.frame_paths[:n], self.gt_boxes[:n], self.frame_numbers[:n], self.group)
 
     def frames(self) -> Iterator[np.ndarray]:
         """The frames as BGR uint8 arrays (grayscale JPEGs come back 3-channel).
@@ -176,11 +182,12 @@ def _frames_of(folder: Path) -> tuple[list[Path], list[int]]:
     paths = [p for p in img_dir.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
     if not paths:
         raise ValueError(f"{folder} is not an OTB sequence: img/ holds no .jpg/.png images")
-    bad = [p.name for p in paths if not p.stem.isdigit()]
+    numbers = {p: _FRAME_NUMBER.search(p.stem) for p in paths}
+    bad = [p.name for p, m in numbers.items() if m is None]
     if bad:
-        raise ValueError(f"{img_dir}: image names must be frame numbers, got {bad[0]!r}")
-    paths.sort(key=lambda p: int(p.stem))
-    return paths, [int(p.stem) for p in paths]
+        raise ValueError(f"{img_dir}: image names must end in their frame number, got {bad[0]!r}")
+    paths.sort(key=lambda p: int(numbers[p].group(1)))
+    return paths, [int(numbers[p].group(1)) for p in paths]
 
 
 def _gt_files(folder: Path) -> dict[str, Path]:
@@ -241,20 +248,32 @@ def list_sequences(root: str | Path) -> list[str]:
     return names
 
 
-def default_root() -> Path | None:
-    """``../shared/data/otb`` beside the repository (or beside the working directory), if it exists.
+def shared_data() -> Path | None:
+    """``../shared/data`` beside the repository (or beside the working directory), if it exists.
 
     Returns
     -------
     Path or None
         The folder; None when neither exists.
     """
-    here = Path(__file__).resolve().parents[1]
-    for base in (here, Path.cwd()):
-        cand = base.parent / "shared" / "data" / "otb"
+    repository = Path(__file__).resolve().parents[2]
+    for base in (repository, Path.cwd()):
+        cand = base.parent / "shared" / "data"
         if cand.is_dir():
             return cand
     return None
+
+
+def default_root() -> Path | None:
+    """``../shared/data/otb``, if it exists (:func:`shared_data`)."""
+    data = shared_data()
+    return data / "otb" if data is not None and (data / "otb").is_dir() else None
+
+
+def default_roots() -> list[Path]:
+    """The folders of sequences in ``../shared/data`` that exist: ``otb`` and ``uav``."""
+    data = shared_data()
+    return [] if data is None else [data / g for g in ("otb", "uav") if (data / g).is_dir()]
 
 
 def _resolve(path_or_name: str | Path, root: str | Path | None) -> tuple[Path, str]:
@@ -262,9 +281,8 @@ def _resolve(path_or_name: str | Path, root: str | Path | None) -> tuple[Path, s
     p = Path(path_or_name)
     candidates = [p]
     if not p.is_absolute() and len(p.parts) == 1:
-        base = Path(root) if root is not None else default_root()
-        if base is not None:
-            candidates.insert(0, base / p)
+        bases = [Path(root)] if root is not None else default_roots()
+        candidates[:0] = [base / p for base in bases]
     for cand in candidates:
         if cand.is_dir():
             return cand, cand.name
@@ -305,4 +323,4 @@ def load_sequence(path_or_name: str | Path, root: str | Path | None = None) -> S
     boxes = parse_groundtruth(gts[name])
     if len(boxes) != len(paths):
         raise ValueError(f"{gts[name]}: {len(boxes)} ground-truth boxes for {len(paths)} images in {folder / 'img'}")
-    return Sequence(name, tuple(paths), boxes, tuple(numbers))
+    return Sequence(name, tuple(paths), boxes, tuple(numbers), folder.parent.name)

@@ -30,7 +30,7 @@ import cv2
 import numpy as np
 
 from iemd_ros.evaluation.metrics import OTB_THRESHOLDS, PRECISION_THRESHOLD, SequenceScores, score_sequence, valid_boxes
-from iemd_ros.datasets.otb import Sequence, default_root, is_sequence_folder, list_sequences, load_sequence
+from iemd_ros.datasets.otb import Sequence, default_roots, is_sequence_folder, list_sequences, load_sequence
 from iemd_ros.tracking import IemdTracker, TrackerConfig
 
 DEFAULT_TRACKERS = ("iemd", "csrt", "kcf")
@@ -384,10 +384,26 @@ def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
             s = results[trk][name]
             lines.append(row(name, trk, s, s["n_frames"]))
     lines.append("-" * len(header))
-    for trk in trackers:
-        m = results[trk][MEAN]
-        lines.append(row(f"MEAN ({m['n_sequences']})", trk, m, m["n_frames"]))
+    means = [key for key in next(iter(results.values())) if key.startswith(MEAN + " ")] + [MEAN]
+    for key in means:
+        for trk in trackers:
+            m = results[trk][key]
+            label = key.upper().replace(MEAN.upper() + " ", "MEAN ")[:9]
+            lines.append(row(f"{label} ({m['n_sequences']})", trk, m, m["n_frames"]))
     return "\n".join(lines)
+
+
+def group_mean_key(group: str) -> str:
+    """The results' key of the mean over one group of sequences (``mean otb``)."""
+    return f"{MEAN} {group}"
+
+
+def _groups(sequences: list[Sequence]) -> dict[str, list[str]]:
+    """Group -> its sequences' names, when the sequences come from more than one group (else empty)."""
+    groups: dict[str, list[str]] = {}
+    for s in sequences:
+        groups.setdefault(s.group, []).append(s.name)
+    return groups if len(groups) > 1 else {}
 
 
 def collect_sequences(inputs: list[str], wanted: list[str] | None) -> list[Sequence]:
@@ -416,10 +432,9 @@ def collect_sequences(inputs: list[str], wanted: list[str] | None) -> list[Seque
 def _select_targets(inputs: list[str], wanted: list[str] | None) -> dict[str, Path]:
     """The targets :func:`collect_sequences` loads, in order: name -> the root folder it lives in."""
     if not inputs:
-        root = default_root()
-        if root is None:
-            raise ValueError("no OTB root given and ../shared/data/otb does not exist")
-        inputs = [str(root)]
+        inputs = [str(root) for root in default_roots()]
+        if not inputs:
+            raise ValueError("no folder of sequences given, and ../shared/data has neither otb/ nor uav/")
     found: dict[str, Path] = {}  # target name -> root folder it lives in
     for item in inputs:
         path = Path(item)
@@ -515,6 +530,9 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
                      f"Success plot of OPE - {seq.name}", out / f"success_{seq.name}.png")
     for trk in trackers:
         results[trk][MEAN] = mean_scores(per_seq_scores[trk])
+        for group, members in _groups(sequences).items():
+            results[trk][group_mean_key(group)] = mean_scores(
+                [s for s, seq in zip(per_seq_scores[trk], sequences) if seq.group == group])
     plot_success({t: results[t][MEAN]["success_curve"] for t in trackers},
                  f"Success plots of OPE ({len(sequences)} sequences)", out / "success_overall.png")
     doc = {
@@ -531,6 +549,7 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
         "trackers": trackers,
         **({"iemd_config": configs.get("iemd", TrackerConfig()).to_dict()} if "iemd" in trackers else {}),
         "sequences": [s.name for s in sequences],
+        "groups": {s.name: s.group for s in sequences},
         "ground_truth": {s.name: s.gt_boxes.tolist() for s in sequences},
         "frame_numbers": {s.name: list(s.frame_numbers) for s in sequences},
         "results": results,

@@ -1,0 +1,100 @@
+"""Published trackers' results on the same sequences, printed beside a run (``iemd-eval --published``).
+
+The file is ``../shared/anchors/published_results.json``: ``{set: {tracker: {sequence: {avg_overlap, auc, prec20}}}}``
+in percent, scored with the same one-pass protocol as :mod:`iemd_ros.evaluation.ope`.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from iemd_ros.datasets.otb import shared_data
+
+__all__ = ["default_published", "load_published", "published_means", "format_published", "DEEP"]
+
+# The anchors with deep features (the anchors' README); the others are hand-crafted.
+DEEP = ("LADCF", "MDNet", "CFNet", "SiamFC", "Baseline")
+
+
+def default_published() -> Path | None:
+    """``../shared/anchors/published_results.json``, if it exists."""
+    data = shared_data()
+    path = None if data is None else data.parent / "anchors" / "published_results.json"
+    return path if path is not None and path.is_file() else None
+
+
+def load_published(path) -> dict:
+    """The published results of ``path``.
+
+    Raises
+    ------
+    ValueError
+        For a file that cannot be read or does not have the layout ``{set: {tracker: {sequence: {...}}}}``.
+    """
+    path = Path(path)
+    try:
+        doc = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"cannot read published results {path}: {exc}") from None
+    ok = isinstance(doc, dict) and all(isinstance(t, dict) and all(isinstance(s, dict) for s in t.values())
+                                       for t in doc.values())
+    if not ok:
+        raise ValueError(f"{path}: expected {{set: {{tracker: {{sequence: {{avg_overlap, auc}}}}}}}}")
+    return doc
+
+
+def is_hand_crafted(tracker: str) -> bool:
+    """Whether a published tracker uses hand-crafted features (``LADCF-HC`` does, ``LADCF`` does not)."""
+    return not (tracker == "LADCF" or tracker.startswith(DEEP[1:]))
+
+
+def published_means(published: dict, names: list[str]) -> dict[str, tuple[list[str], dict[str, tuple[float, float]]]]:
+    """Per set, the run's sequences it holds and every tracker's mean (AO %, AUC %) over them.
+
+    A tracker enters a set's means only when it has every one of those sequences.
+    """
+    out = {}
+    for group, trackers in published.items():
+        held = [n for n in names if any(n in seqs for seqs in trackers.values())]
+        if not held:
+            continue
+        means = {}
+        for tracker, seqs in trackers.items():
+            if all(n in seqs for n in held):
+                means[tracker] = (sum(seqs[n]["avg_overlap"] for n in held) / len(held),
+                                  sum(seqs[n]["auc"] for n in held) / len(held))
+        out[group] = (held, means)
+    return out
+
+
+def format_published(published: dict, results: dict, trackers: list[str]) -> str:
+    """The run's trackers ranked among the published ones, per set, on the sequences both have.
+
+    Parameters
+    ----------
+    published : dict
+        :func:`load_published`'s document.
+    results : dict
+        Tracker -> sequence name -> figures (fractions), as :func:`~iemd_ros.evaluation.ope.evaluate` records them.
+    trackers : list of str
+        The run's trackers.
+
+    Returns
+    -------
+    str
+        One table per set: tracker, mean AO %, mean AUC %, hand-crafted or deep, the run's rows marked.
+    """
+    names = [n for n in next(iter(results.values())) if not n.startswith("mean")]
+    lines = []
+    for group, (held, means) in published_means(published, names).items():
+        rows = [(ao, auc, t, "deep" if not is_hand_crafted(t) else "hand-crafted", "") for t, (ao, auc) in means.items()]
+        for t in trackers:
+            ao = 100 * sum(results[t][n]["average_overlap"] for n in held) / len(held)
+            auc = 100 * sum(results[t][n]["success_auc"] for n in held) / len(held)
+            rows.append((ao, auc, t, "", "<- this run"))
+        lines += [f"published results, set {group}: {len(held)} sequence(s) of this run "
+                  f"({', '.join(held)})", f"{'tracker':<18} {'AO%':>6} {'AUC%':>6}  features"]
+        lines += [f"{t:<18} {ao:6.1f} {auc:6.1f}  {kind:<12} {mark}".rstrip()
+                  for ao, auc, t, kind, mark in sorted(rows, reverse=True)]
+        lines.append("")
+    return "\n".join(lines).rstrip() or "published results: none of this run's sequences are in the file"
