@@ -9,6 +9,7 @@ import json
 from pathlib import Path
 
 from iemd_ros.datasets.otb import shared_data
+from iemd_ros.evaluation.ope import MEAN
 
 __all__ = ["default_published", "load_published", "published_means", "format_published", "DEEP"]
 
@@ -84,7 +85,7 @@ def format_published(published: dict, results: dict, trackers: list[str]) -> str
     str
         One table per set: tracker, mean AO %, mean AUC %, hand-crafted or deep, the run's rows marked.
     """
-    names = [n for n in next(iter(results.values())) if not n.startswith("mean")]
+    names = [n for n in next(iter(results.values())) if n != MEAN and not n.startswith(MEAN + " ")]
     lines = []
     for group, (held, means) in published_means(published, names).items():
         rows = [(ao, auc, t, "deep" if not is_hand_crafted(t) else "hand-crafted", "") for t, (ao, auc) in means.items()]

@@ -85,7 +85,7 @@ def statuses(d: dict) -> list[Status]:
 
     return [
         Status(Part.TRACKING, *_tracking(d), vals(
-            "state", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
+            "state", "held", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
             "processing_ms_max", "processing_rate_hz", "inits", "resets", "frame_reason")),
         Status(Part.IMAGE, *_image(d), vals(
             "frames_received", "frames_processed", "frames_dropped", "frames_rejected", "images_malformed",

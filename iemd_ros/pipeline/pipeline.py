@@ -581,6 +581,7 @@ class TrackingPipeline:
             r = self._last_result
             d["emd"] = math.nan if r is None else r.emd
             d["iterations"] = 0 if r is None else r.iterations
+            d["held"] = r is not None and r.held
             d["imu_stored"] = len(self._predictor.buffer)
             d["imu_pending"] = d["imu_stored"] if camera is None else 0     # held until camera_info
             d["bias_status"] = self._predictor.bias_estimator.status
