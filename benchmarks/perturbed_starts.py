@@ -27,6 +27,7 @@ from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.metrics import score_sequence
 from iemd_ros.datasets.otb import load_sequence
+from iemd_ros.evaluation.split import PARTS, split_names
 
 # Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, and the box's scale.
 DIAGONALS = ((0.0, 0.0, 1.0), (1.0, 1.0, 1.0), (-1.0, 1.0, 1.0), (1.0, -1.0, 1.0), (-1.0, -1.0, 1.0))
@@ -62,7 +63,9 @@ def run(job):
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--sequences", default=None, help="comma-separated (default: all in ../shared/data/otb)")
+    parser.add_argument("--sequences", default=None,
+                        help="comma-separated (default: all in ../shared/data/otb and ../shared/data/uav)")
+    parser.add_argument("--split", choices=PARTS, default=None, help="only this part of the fixed split")
     parser.add_argument("--peers", default="csrt", help="comma-separated OpenCV peers (default: csrt)")
     parser.add_argument("--config", action="append", help="iEMD TrackerConfig values as a Python dict (repeatable)")
     parser.add_argument("--shift", type=float, default=0.1, help="start shift, fraction of the box size")
@@ -71,6 +74,8 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=2)
     args = parser.parse_args()
     names = sequence_names(args.sequences)
+    if args.split is not None:
+        names = [n for n in names if n in split_names(args.split)]
     # Checked here, before any run: a bad key or peer fails at once with its own message.
     runs = [(f"iemd {c}" if args.config else "iemd", "iemd", TrackerConfig.from_dict(ast.literal_eval(c)))
             for c in (args.config or ["{}"])]
@@ -80,6 +85,7 @@ def main() -> None:
     runs += [(peer, peer, None) for peer in peers]
     with Pool(args.jobs) as pool:
         results = pool.map(run, [(name, runs, args.shift, START_SETS[args.starts]) for name in names], chunksize=1)
+    groups = {n: load_sequence(n).group for n in names}
     n_starts = len(START_SETS[args.starts])
     which = "the diagonals" if args.starts == "diagonal" else "the diagonals and the axes, and scaled by 0.8-1.2"
     print(f"{len(names)} sequences x {n_starts} starts (ground truth, and shifted by {args.shift:g} of its size "
@@ -90,6 +96,9 @@ def main() -> None:
         speed = np.median([ms for _, ms in rows])
         starts = " ".join(f"{v:4.1f}" for v in overlap.mean(axis=0))
         print(f"{label:60s} mean AO {overlap.mean():5.1f} %  per start {starts}  median update {speed:.1f} ms")
+        for group in sorted(set(groups.values())):
+            rows_of = [k for k, n in enumerate(names) if groups[n] == group]
+            print(f"    {group}: mean AO {overlap[rows_of].mean():5.1f} % over {len(rows_of)} sequences x {n_starts}")
         print("    " + " ".join(f"{n}={v:.1f}" for n, v in zip(names, overlap.mean(axis=1))))
 
 
