@@ -19,7 +19,7 @@ from pathlib import Path
 
 from iemd_ros.common.cli import CliParser, cli_main
 from iemd_ros.evaluation.ope import (DEFAULT_OUT, DEFAULT_TRACKERS, TRACKERS, collect_sequences, evaluate,
-                                     format_table, make_tracker)
+                                     format_long_term, format_table, make_tracker)
 from iemd_ros.evaluation.published import default_published, format_published, load_published
 from iemd_ros.evaluation.split import PARTS, split_names
 from iemd_ros.pipeline import PipelineConfig
@@ -99,6 +99,10 @@ def main(argv: list[str] | None = None) -> int:
         doc = evaluate(sequences, trackers, args.out, configs=configs)  # unreadable image, unwritable --out: one line, exit 2
         print()
         print(format_table(doc["results"], trackers, doc["sequences"]))
+        long_term = format_long_term(doc)
+        if long_term:
+            print()
+            print(long_term)
         if published is not None:
             print()
             print(format_published(published, doc["results"], trackers))
