@@ -93,7 +93,8 @@ def statuses(d: dict) -> list[Status]:
         Status(Part.IMU, *_imu(d), vals(
             "imu_received", "imu_rejected", "imu_out_of_order", "imu_saturated", "imu_stored", "imu_pending",
             "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status")),
-        Status(Part.CAMERA, *_camera(d), vals("camera", "camera_infos", "camera_infos_rejected", "camera_error")),
+        Status(Part.CAMERA, *_camera(d), vals("camera", "camera_infos", "camera_infos_rejected", "camera_error",
+                                              "camera_misfit")),
     ]
 
 
@@ -142,6 +143,8 @@ def _camera(d: dict) -> tuple[Level, str]:
         return Level.OK, "no camera_info (not needed: gyro disabled)"
     if d["camera_error"]:
         return Level.WARN, f"latest camera_info rejected ({d['camera_error']}); keeping the previous one"
+    if d["camera_misfit"]:
+        return Level.WARN, f"camera model does not fit the images, no gyro prior: {d['camera_misfit']}"
     return Level.OK, "camera model received"
 
 

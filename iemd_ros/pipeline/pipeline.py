@@ -95,7 +95,7 @@ class TrackingPipeline:
                              imu_received=0, imu_rejected=0, imu_out_of_order=0, imu_saturated=0,
                              clock_resets=0, camera_infos=0, camera_infos_rejected=0, inits=0, resets=0)
         self._last = dict(frame_reason="", gyro_reason="", imu_reason="", image_error="", camera_error="",
-                          drop_reason="")
+                          drop_reason="", camera_misfit="")
         self._last_result: FrameResult | None = None
         self._image_bad = False          # the latest image message was malformed
         self._stamp_rejected = False     # the latest frame was rejected for its stamp
@@ -464,7 +464,7 @@ class TrackingPipeline:
                     self._recent.append((t, "uninitialized"))
                     return FrameResult(stamp_ns=t, state=TrackState.UNINITIALIZED,
                                        reason="no target: waiting for an initial box")
-                prior, gyro_box, gyro_reason = self._gyro_prior(t)
+                prior, gyro_box, gyro_reason = self._gyro_prior(t, frame)
             start = time.perf_counter()
             try:
                 result = self._tracker.update(frame, prior=prior)
@@ -487,6 +487,8 @@ class TrackingPipeline:
         if back > self._cfg.clock_reset_ms * 1e6:
             self.counters["clock_resets"] += 1
             self._last["frame_reason"] = f"image clock jumped back by {_ms(back)}: treated as a clock reset"
+            self._recent.clear()                       # the rates count from the reset
+            self._recent_proc.clear()
             if self._ref is not None:
                 self._ref = (t, self._ref[1], self._ref[2])     # no rotation can be integrated across it
             newest = self._predictor.buffer.t_newest_ns
@@ -497,16 +499,26 @@ class TrackingPipeline:
             return f"image stamp {t} ns repeats the previous frame's"
         return f"image stamp went back by {_ms(back)} (previous frame {last} ns)"
 
-    def _gyro_prior(self, t: int):
+    def _gyro_prior(self, t: int, frame: np.ndarray):
         """(prior or None, predicted box or None, reason) for the frame at ``t``."""
         if not self._cfg.use_gyro:
             return None, None, "gyro disabled (use_gyro is false)"
-        if self._predictor.camera is None:
+        camera = self._predictor.camera
+        if camera is None:
             return None, None, "no camera_info received: the gyro prior needs K"
+        try:
+            camera.check_image(frame.shape[1], frame.shape[0])
+            self._last["camera_misfit"] = ""
+        except ValueError as exc:
+            self._last["camera_misfit"] = str(exc)
+            return None, None, f"no gyro prior: {exc}"
         t_ref, box, _ = self._ref
         if t == t_ref:
             return None, None, "frame has the window's own stamp"
-        pred = self._predictor.predict(t_ref, t, box=box)
+        try:
+            pred = self._predictor.predict(t_ref, t, box=box)
+        except ValueError as exc:      # e.g. a rotation that cannot be integrated: the frame goes on without it
+            return None, None, f"no gyro prior: {exc}"
         if pred.prior is None:
             return None, None, pred.reason
         gyro_box = tuple(float(v) for v in pred.box) if pred.box is not None else None
@@ -549,7 +561,7 @@ class TrackingPipeline:
         Returns
         -------
         dict
-            The texts frame_reason, gyro_reason, imu_reason, image_error, camera_error, drop_reason.
+            The texts frame_reason, gyro_reason, imu_reason, image_error, camera_error, drop_reason and camera_misfit.
         """
         with self._lock:
             return dict(self._last)
