@@ -86,7 +86,7 @@ def statuses(d: dict) -> list[Status]:
     return [
         Status(Part.TRACKING, *_tracking(d), vals(
             "state", "held", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
-            "processing_ms_max", "processing_rate_hz", "inits", "resets", "frame_reason")),
+            "processing_ms_max", "processing_rate_hz", "inits", "resets", "updates_abandoned", "frame_reason")),
         Status(Part.IMAGE, *_image(d), vals(
             "frames_received", "frames_processed", "frames_dropped", "frames_rejected", "images_malformed",
             "input_rate_hz", "processing_rate_hz", "recent_dropped", "image_error", "drop_reason", "clock_resets")),
@@ -99,6 +99,8 @@ def statuses(d: dict) -> list[Status]:
 
 
 def _tracking(d: dict) -> tuple[Level, str]:
+    if d["watchdog_reason"]:
+        return Level.ERROR, f"latest frame: {d['watchdog_reason']} ({d['updates_abandoned']} abandoned so far)"
     if d["state"] == "uninitialized":
         return Level.WARN, "no target: set the initial_box parameter or publish on ~/init"
     if d["state"] == "lost":

@@ -38,6 +38,7 @@ from iemd_ros.gyro.predictor import warm_up as warm_up_gyro
 from iemd_ros.pipeline.config import PipelineConfig
 from iemd_ros.pipeline.diagnostics import Status, rate_hz, statuses
 from iemd_ros.pipeline.results import INIT_REASON, FrameResult, Rejection, TrackState
+from iemd_ros.pipeline.watchdog import Abandoned, Watchdog
 from iemd_ros.tracking import IemdTracker
 from iemd_ros.tracking.tracker import warm_up as warm_up_tracker
 
@@ -93,9 +94,11 @@ class TrackingPipeline:
         self.counters = dict(frames_received=0, frames_processed=0, frames_uninitialized=0, frames_dropped=0,
                              frames_rejected=0, images_malformed=0, frames_lost=0, frames_held=0, gyro_used=0, gyro_unused=0,
                              imu_received=0, imu_rejected=0, imu_out_of_order=0, imu_saturated=0,
-                             clock_resets=0, camera_infos=0, camera_infos_rejected=0, inits=0, resets=0)
+                             clock_resets=0, camera_infos=0, camera_infos_rejected=0, inits=0, resets=0,
+                             updates_abandoned=0)
         self._last = dict(frame_reason="", gyro_reason="", imu_reason="", image_error="", camera_error="",
-                          drop_reason="", camera_misfit="")
+                          drop_reason="", camera_misfit="", watchdog_reason="")
+        self._watchdog = Watchdog()
         self._last_result: FrameResult | None = None
         self._image_bad = False          # the latest image message was malformed
         self._stamp_rejected = False     # the latest frame was rejected for its stamp
@@ -412,7 +415,7 @@ class TrackingPipeline:
                 self._ref = (int(stamp_ns), box, frame)
                 self._state, self._lost_run = TrackState.TRACKING, 0
                 self.counters["inits"] += 1
-                self._last["frame_reason"] = ""
+                self._last["frame_reason"] = self._last["watchdog_reason"] = ""
                 if self._last_stamp is None or int(stamp_ns) > self._last_stamp:
                     self._last_stamp = int(stamp_ns)
         return FrameResult(stamp_ns=int(stamp_ns), state=TrackState.TRACKING, box=box, score=1.0, reason=INIT_REASON,
@@ -424,6 +427,7 @@ class TrackingPipeline:
             self._tracker, self._ref = None, None
             self._state, self._lost_run = TrackState.UNINITIALIZED, 0
             self._last_result = None
+            self._last["watchdog_reason"] = ""
             self.counters["resets"] += 1
 
     def process(self, frame: np.ndarray, stamp_ns: int) -> FrameResult:
@@ -467,16 +471,39 @@ class TrackingPipeline:
                 prior, gyro_box, gyro_reason = self._gyro_prior(t, frame)
             start = time.perf_counter()
             try:
-                result = self._tracker.update(frame, prior=prior)
-            except ValueError as exc:
-                if prior is None:
-                    raise
-                gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
-                prior, gyro_box = None, None
-                result = self._tracker.update(frame)
+                try:
+                    result = self._update(frame, prior)
+                except ValueError as exc:
+                    if prior is None:
+                        raise
+                    gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
+                    prior, gyro_box = None, None
+                    result = self._update(frame, None)
+            except Abandoned:
+                return self._abandon(t)
             ms = (time.perf_counter() - start) * 1e3
             with self._lock:
                 return self._record(frame, t, result, prior is not None, gyro_reason, gyro_box, ms)
+
+    def _update(self, frame, prior):
+        """The tracker's update, under the watchdog (:class:`Abandoned` when it overruns ``watchdog_ms``)."""
+        tracker = self._tracker
+        return self._watchdog.run(lambda: tracker.update(frame, prior=prior), self._cfg.watchdog_ms / 1e3)
+
+    def _abandon(self, t: int) -> FrameResult:
+        """The result of the frame at ``t`` whose update was abandoned; the tracker is rebuilt at its last good
+        window (the init frame or the last frame not lost), the abandoned one is left to its thread."""
+        t_ref, box, ref_frame = self._ref
+        tracker = IemdTracker(self._cfg.tracker)
+        tracker.init(ref_frame, box)
+        reason = (f"tracker update abandoned after {self._cfg.watchdog_ms:g} ms (watchdog_ms); the tracker is rebuilt "
+                  f"at its window of the frame stamped {t_ref} ns")
+        with self._lock:
+            self._tracker = tracker
+            self.counters["updates_abandoned"] += 1
+            self._last["watchdog_reason"] = self._last["frame_reason"] = reason
+            self._recent.append((t, Rejection.ABANDONED.value))
+            return FrameResult(stamp_ns=t, state=self._state, rejection=Rejection.ABANDONED, reason=reason)
 
     def _check_stamp(self, t: int) -> str:
         """"" if a frame stamped ``t`` can be processed, else why not (handles clock resets)."""
@@ -542,6 +569,7 @@ class TrackingPipeline:
         score = math.exp(-emd / self._cfg.score_emd_scale) if not result.lost and math.isfinite(emd) else 0.0
         self._last["gyro_reason"] = gyro_reason
         self._last["frame_reason"] = result.reason
+        self._last["watchdog_reason"] = ""
         self._recent.append((t, self._state.value))
         self._recent_proc.append((t, ms, gyro_used))
         predicted = None if result.predicted_box is None else tuple(float(v) for v in result.predicted_box)

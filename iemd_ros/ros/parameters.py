@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 
-from iemd_ros.common.limits import LIMITS
+from iemd_ros.common.limits import IMAGE_SIDE, LIMITS
 from iemd_ros.common.params import Choice, Spec, coerce, number_text, param, specs
 from iemd_ros.messages.conversions import CLASS_ID, DETECTION_ID
 from iemd_ros.pipeline.config import PipelineConfig
@@ -40,7 +40,8 @@ class NodeConfig:
     """The node's own parameters (the pipeline's are :class:`~iemd_ros.pipeline.PipelineConfig`)."""
 
     initial_box: tuple[float, ...] = param((), "[x, y, w, h] of the target, applied to the next frame (0-based "
-                                           "top-left + size); [] for none", unit="px")
+                                           "top-left + size); [] for none", unit="px",
+                                           range=(-IMAGE_SIDE.high, IMAGE_SIDE.high))
     reliable_qos: bool = param(False, "reliable QoS for image, imu and camera_info instead of sensor-data "
                                "(best effort)", read_only=True)
     image_transport: ImageTransport = param(ImageTransport.RAW, "raw: sensor_msgs/Image on image; compressed: "
