@@ -36,7 +36,6 @@ import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter as RclpyParameter
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
@@ -54,7 +53,7 @@ from iemd_ros.pipeline import FrameResult, ImuWait, Level, Part, PipelineConfig,
 from iemd_ros.pipeline.drawing import draw_result
 from iemd_ros.ros.messages import RCLPY_MESSAGES
 from iemd_ros.ros.parameters import NODE_NAME, ImageTransport, NodeConfig, descriptor, parameters
-from iemd_ros.ros.spin import spin_until_shutdown
+from iemd_ros.ros.spin import spin_until_shutdown, stopped_by_shutdown
 
 __all__ = ["TrackerNode", "main", "NODE_NAME"]
 
@@ -437,10 +436,15 @@ def main(args=None) -> int:
         print(f"{NODE_NAME}: invalid parameters: {one_line(exc)}", file=sys.stderr)
         rclpy.try_shutdown()
         return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
+    except BaseException as exc:  # a signal during start-up
+        if not stopped_by_shutdown(exc):
+            raise
         rclpy.try_shutdown()
         return 0
-    spin_until_shutdown(node)
+    try:
+        spin_until_shutdown(node)
+    except KeyboardInterrupt:  # a second Ctrl-C before the clean-up could ignore it: stopping all the same
+        pass
     return 0
 
 
