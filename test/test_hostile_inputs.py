@@ -169,6 +169,16 @@ def test_a_template_size_beyond_its_range_is_refused(size):
         TrackerConfig(template_size=size)
 
 
+@pytest.mark.parametrize("layout, patches", [(dict(template_size=(64, 64), patch_step=2), 841),
+                                             (dict(template_size=(48, 48), patch_size=(2, 2), patch_step=2), 576),
+                                             (dict(template_size=(96, 96), patch_size=(32, 32)), 289)])
+def test_a_template_layout_that_would_overrun_the_watchdog_on_every_frame_is_refused(layout, patches):
+    """Within their ranges, these layouts took 5.5, 1.5 and 1.6 s per update (docs/decisions.md#patch-budget)."""
+    with pytest.raises(ValueError, match=rf"code a window with {patches} patches of \d+ pixels; at most 529"):
+        TrackerConfig(**layout)
+    TrackerConfig(template_size=(96, 96))                                # 529 patches of 8x8: taken
+
+
 def test_the_gyro_saturation_cannot_be_switched_off():
     with pytest.raises(ValueError, match=r"gyro.saturation must be in \[1, 1000\] rad/s, got 0"):
         GyroConfig(saturation=0.0)

@@ -4,7 +4,7 @@ The parameters' ranges are in their declarations (:func:`iemd_ros.common.params.
 parameter ``gyro.saturation``); these are the ranges of message fields: image sizes, the camera matrix, target boxes.
 They are checked where a message becomes numbers (:mod:`iemd_ros.messages.conversions`, :mod:`iemd_ros.gyro.camera`,
 the tracker's init), so that no absurd or non-finite value reaches OpenCV or numba; docs/parameters.md lists them
-(generated, :func:`iemd_ros.ros.parameters.parameter_table`)::
+(generated, :func:`iemd_ros.ros.parameters.parameter_table`), docs/decisions.md#input-limits says why::
 
     IMAGE_SIDE.check("image width", 100_000)               # ValueError: image width = 100000 px is out of [2, ...
     FOCAL_LENGTH.check("camera_info k[0] (fx)", 1e8, 640)  # the range scaled by the image's larger side

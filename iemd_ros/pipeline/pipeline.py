@@ -479,8 +479,8 @@ class TrackingPipeline:
                     gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
                     prior, gyro_box = None, None
                     result = self._update(frame, None)
-            except Abandoned:
-                return self._abandon(t)
+            except Abandoned as exc:
+                return self._abandon(t, exc)
             ms = (time.perf_counter() - start) * 1e3
             with self._lock:
                 return self._record(frame, t, result, prior is not None, gyro_reason, gyro_box, ms)
@@ -490,17 +490,22 @@ class TrackingPipeline:
         tracker = self._tracker
         return self._watchdog.run(lambda: tracker.update(frame, prior=prior), self._cfg.watchdog_ms / 1e3)
 
-    def _abandon(self, t: int) -> FrameResult:
-        """The result of the frame at ``t`` whose update was abandoned; the tracker is rebuilt at its last good
-        window (the init frame or the last frame not lost), the abandoned one is left to its thread."""
+    def _abandon(self, t: int, exc: Abandoned) -> FrameResult:
+        """The result of the frame at ``t`` whose update was abandoned (or not started: ``exc.ran`` False); the
+        tracker is rebuilt at its last good window (the init frame or the last frame not lost), the abandoned one is
+        left to its thread."""
         t_ref, box, ref_frame = self._ref
-        tracker = IemdTracker(self._cfg.tracker)
-        tracker.init(ref_frame, box)
-        reason = (f"tracker update abandoned after {self._cfg.watchdog_ms:g} ms (watchdog_ms); the tracker is rebuilt "
-                  f"at its window of the frame stamped {t_ref} ns")
+        if exc.ran:
+            tracker = IemdTracker(self._cfg.tracker)
+            tracker.init(ref_frame, box)
+            reason = (f"tracker update abandoned after {self._cfg.watchdog_ms:g} ms (watchdog_ms); the tracker is "
+                      f"rebuilt at its window of the frame stamped {t_ref} ns")
+        else:
+            tracker = self._tracker
+            reason = f"tracker update {exc} (watchdog_ms {self._cfg.watchdog_ms:g} ms): frame not tracked"
         with self._lock:
             self._tracker = tracker
-            self.counters["updates_abandoned"] += 1
+            self.counters["updates_abandoned"] += exc.ran
             self._last["watchdog_reason"] = self._last["frame_reason"] = reason
             self._recent.append((t, Rejection.ABANDONED.value))
             return FrameResult(stamp_ns=t, state=self._state, rejection=Rejection.ABANDONED, reason=reason)

@@ -7,7 +7,19 @@ __all__ = ["Watchdog", "Abandoned"]
 
 
 class Abandoned(Exception):
-    """The call did not return in time; its thread was left to it (it ends when the call returns, if ever)."""
+    """The call did not return in time; its thread was left to it (it ends when the call returns, if ever).
+
+    Parameters
+    ----------
+    message : str
+        What happened.
+    ran : bool
+        False when the call was not even started, because too many abandoned calls are still running.
+    """
+
+    def __init__(self, message: str, ran: bool = True):
+        super().__init__(message)
+        self.ran = ran
 
 
 class _Runner(threading.Thread):
@@ -43,11 +55,19 @@ class Watchdog:
     A call that overruns is abandoned: :meth:`run` raises :class:`Abandoned`, the thread is left to the call (a
     daemon: it does not keep the process alive) and the next call gets a new thread.  Python cannot stop a thread,
     so an abandoned call still runs (and uses a core) until it returns, if it ever does; only code that releases
-    the GIL (OpenCV, POT) lets the caller go on meanwhile.
+    the GIL (OpenCV, POT) lets the caller go on meanwhile.  While ``max_running`` abandoned calls still run, a new
+    call is not started (:class:`Abandoned` with ``ran`` False), so that they cannot take every core.
+
+    Parameters
+    ----------
+    max_running : int, optional
+        Abandoned calls that may still run while new ones start.
     """
 
-    def __init__(self):
+    def __init__(self, max_running: int = 2):
         self._runner: _Runner | None = None
+        self._left: list[_Runner] = []   # the threads of abandoned calls
+        self.max_running = max_running
         self.abandoned = 0  # calls abandoned so far
 
     def run(self, call, timeout_s: float):
@@ -68,10 +88,14 @@ class Watchdog:
         Raises
         ------
         Abandoned
-            When ``call`` has not returned within ``timeout_s``.
+            When ``call`` has not returned within ``timeout_s``, or was not started (``ran`` False) because
+            ``max_running`` abandoned calls still run.
         Exception
             What ``call`` raised.
         """
+        self._left = [r for r in self._left if r.is_alive()]
+        if len(self._left) >= self.max_running:
+            raise Abandoned(f"not started: {len(self._left)} abandoned calls are still running", ran=False)
         runner = self._runner
         if runner is None:
             runner = self._runner = _Runner()
@@ -82,6 +106,7 @@ class Watchdog:
             if not runner.cond.wait_for(lambda: runner.done, timeout_s):
                 runner.abandoned = True          # the thread ends when the call returns
                 self._runner = None
+                self._left.append(runner)
                 self.abandoned += 1
                 raise Abandoned(f"no answer within {timeout_s * 1e3:.0f} ms")
             result, error = runner.result, runner.error
