@@ -8,7 +8,8 @@ with increasing stamps, IMU at 200 Hz, CameraInfo with every frame, sensor-data 
 unless ``--default-transport``), restarting the target with
 ``~/init`` at each pass.  Every ``--sample-s`` seconds it reads the tracker's RSS (``/proc/<pid>/status``) and the
 frames answered with a detection.  It prints the RSS at the start, after 1 minute and at the end, and the slope of a
-least-squares line through the samples after the first minute (MB per hour).  It stops by itself after
+least-squares line through the samples after the first minute (MB per hour), and with each sample the tracker's
+own counts and its worst status (tracking, image input) from /diagnostics.  It stops by itself after
 ``--minutes`` and stops the tracker with SIGINT.
 """
 from __future__ import annotations
@@ -48,6 +49,7 @@ def main(argv=None) -> int:
     ap.add_argument("--height", type=int, default=480)
     ap.add_argument("--frames", type=int, default=150, help="frames of the sequence played over and over")
     ap.add_argument("--sample-s", type=float, default=10.0)
+    ap.add_argument("--log", default=None, help="file for the tracker's log (default: discarded)")
     ap.add_argument("--default-transport", action="store_true",
                     help="Fast DDS's default transport instead of config/fastdds_shm.xml (docs/node.md#transport)")
     args = ap.parse_args(argv)
@@ -61,6 +63,7 @@ def main(argv=None) -> int:
     from rclpy.executors import SingleThreadedExecutor
     from rclpy.qos import QoSProfile, qos_profile_sensor_data
     from sensor_msgs.msg import CameraInfo, Image, Imu
+    from diagnostic_msgs.msg import DiagnosticArray
     from vision_msgs.msg import Detection2D, Detection2DArray
 
     from iemd_ros.datasets.synthetic import generate
@@ -68,8 +71,9 @@ def main(argv=None) -> int:
 
     seq = generate(n_frames=args.frames, width=args.width, height=args.height, max_rate_deg_s=60.0,
                    target_size_px=64.0, seed=1)
+    log = open(args.log, "w") if args.log else subprocess.DEVNULL
     proc = subprocess.Popen([sys.executable, "-m", "iemd_ros.ros.node", "--ros-args", "-p",
-                             "diagnostics_period_s:=1.0"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                             "diagnostics_period_s:=1.0"], stdout=log, stderr=log, text=True)
     rclpy.init()
     node = rclpy.create_node("iemd_soak_driver")
     img_pub = node.create_publisher(Image, "image", qos_profile_sensor_data)
@@ -84,6 +88,15 @@ def main(argv=None) -> int:
             counts["answered"] += 1
             counts["detected"] += bool(msg.detections)
     node.create_subscription(Detection2DArray, "detections", on_det, 50)
+    diag: dict = {}
+
+    def on_diag(msg):                          # the tracker's own counts and its worst status
+        with lock:
+            for st in msg.status:
+                part = st.name.split(": ", 1)[-1]
+                diag[part] = (st.level[0] if isinstance(st.level, bytes) else int(st.level), st.message)
+                diag.update({kv.key: kv.value for kv in st.values if kv.key.startswith("frames_")})
+    node.create_subscription(DiagnosticArray, "/diagnostics", on_diag, 10)
     ex = SingleThreadedExecutor()
     ex.add_node(node)
     spin = threading.Thread(target=ex.spin, daemon=True)
@@ -138,10 +151,13 @@ def main(argv=None) -> int:
             if now >= next_sample:
                 with lock:
                     samples.append((now - t0, rss_mb(proc.pid), counts["answered"], counts["detected"]))
+                    worst = max(diag.get(p, (0, "")) for p in ("tracking", "image input"))
+                    seen = {k: diag.get(f"frames_{k}", "?") for k in ("received", "processed", "dropped")}
                 next_sample += args.sample_s
                 s = samples[-1]
                 print(f"  {s[0] / 60:6.2f} min  RSS {s[1]:7.1f} MB  sent {n}  answered {s[2]}  with a detection "
-                      f"{s[3]}", flush=True)
+                      f"{s[3]}  tracker: received {seen['received']} processed {seen['processed']} dropped "
+                      f"{seen['dropped']}, level {worst[0]} {worst[1][:80]}", flush=True)
         if proc.poll() is not None:
             print(f"soak: the tracker exited early with status {proc.returncode}", file=sys.stderr)
             return 1
