@@ -113,7 +113,8 @@ def test_camera_info_gives_a_model_within_the_limits_or_a_value_error(k, d, mode
         lo, hi = PRINCIPAL_POINT.bounds(cam.width)
         assert lo <= cam.K[0, 2] <= hi
     pts = np.array([[0.0, 0.0], [cam.K[0, 2], cam.K[1, 2]], [1e4, -1e4]])
-    out = cam.undistort_points(cam.distort_points(pts))           # NaN where the lens model cannot be inverted
+    with np.errstate(over="ignore", invalid="ignore"):           # far points of a strong lens overflow to NaN
+        out = cam.undistort_points(cam.distort_points(pts))       # NaN where the lens model cannot be inverted
     assert out.shape == pts.shape and not np.any(np.isinf(out))
 
 

@@ -367,6 +367,7 @@ class TrackerNode(Node):
         values) tuples."""
         now = time.monotonic()
         timeout = self._node_cfg.input_timeout_s
+        stuck = self._stuck(now)
         out = []
         for s in self.pipeline.statuses():
             level, message, values = s.level, s.message, dict(s.values)
@@ -387,8 +388,8 @@ class TrackerNode(Node):
                             f"no IMU message received on {topic}: tracking without gyro")
                     message = note if level == Level.OK else f"{message}; {note}"
                     level = Level.WARN
-            elif s.part is Part.TRACKING and self._stuck(now):
-                level, message = Level.ERROR, self._stuck(now)
+            elif s.part is Part.TRACKING and stuck:
+                level, message = Level.ERROR, stuck
             elif s.part is Part.TRACKING and self._note is not None:
                 kind, text = self._note
                 values["note"] = text
