@@ -5,12 +5,12 @@
 The tracker runs as ``python -m iemd_ros.ros.node`` (the installed package unless PYTHONPATH says otherwise) on an
 isolated DDS domain on this host; this process publishes a synthetic shaky-camera sequence over and over (bgr8 frames
 with increasing stamps, IMU at 200 Hz, CameraInfo with every frame, sensor-data QoS, over ``config/fastdds_shm.xml``
-unless ``--default-transport``), restarting the target with
-``~/init`` at each pass.  Every ``--sample-s`` seconds it reads the tracker's RSS (``/proc/<pid>/status``) and the
-frames answered with a detection.  It prints the RSS at the start, after 1 minute and at the end, and the slope of a
-least-squares line through the samples after the first minute (MB per hour), and with each sample the tracker's
-own counts and its worst status (tracking, image input) from /diagnostics.  It stops by itself after
-``--minutes`` and stops the tracker with SIGINT.
+unless ``--default-transport``), restarting the target with ``~/init`` at each pass.  Every ``--sample-s`` seconds
+it reads the tracker's RSS (``/proc/<pid>/status``), the frames answered, and the tracker's own counts and worst
+status (tracking, image input) from /diagnostics.  It prints the RSS at the start, after 1 minute and at the end, and
+the slope of a least-squares line through the samples after the first minute and through those of the second half
+(MB per hour).  It stops by itself after ``--minutes`` and stops the tracker with SIGINT.  The tracker's log goes to
+``--log`` or is discarded: never to a pipe nobody reads, where it would block the tracker once the pipe is full.
 """
 from __future__ import annotations
 
@@ -178,9 +178,11 @@ def main(argv=None) -> int:
     one = int(np.argmin(np.abs(t - 60.0)))
     later = t >= 60.0
     last = samples[-1]
+    half = t >= t[-1] / 2
     print(f"RSS start {rss[0]:.1f} MB, after 1 min {rss[one]:.1f} MB ({t[one] / 60:.2f} min), at the end "
           f"{rss[-1]:.1f} MB ({t[-1] / 60:.2f} min); slope after the first minute "
-          f"{slope_mb_per_hour(t[later], rss[later]):+.2f} MB/h")
+          f"{slope_mb_per_hour(t[later], rss[later]):+.2f} MB/h, over the second half "
+          f"{slope_mb_per_hour(t[half], rss[half]):+.2f} MB/h")
     print(f"frames sent {n}, answered {last[2]} ({last[2] / max(n, 1):.1%}), with a detection {last[3]} "
           f"({last[3] / max(n, 1):.1%}); tracker exit status {proc.returncode}")
     return 0
