@@ -58,7 +58,10 @@ setup(
     name=PACKAGE,
     version="0.1.0",
     packages=find_packages(exclude=["test", "test.*"]),
-    package_data={"iemd_ros.evaluation": ["split.json"]},
+    package_data={
+        "iemd_ros.evaluation": ["split.json"],
+        "iemd_ros.tracking": ["data/colour_names.npy"],
+    },
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE}"]),
         (f"share/{PACKAGE}", ["package.xml"]),
@@ -67,7 +70,7 @@ setup(
         (f"lib/{PACKAGE}", ros_executables()),
     ],
     install_requires=["setuptools"],
-    zip_safe=True,
+    zip_safe=False,  # the Colour Names table is read from the installed package folder
     maintainer="iemd_ros maintainers",
     maintainer_email="maintainers@iemd-ros.org",
     description="Gyro-aided iEMD visual tracking for ROS 2 Jazzy",
