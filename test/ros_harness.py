@@ -30,10 +30,11 @@ def stamp_header(header, t_ns: int, frame_id: str = FRAME_ID) -> None:
     header.stamp.sec, header.stamp.nanosec = ns_to_stamp(t_ns)
 
 
-def imu_msg(t_ns: int, w) -> Imu:
-    """A sensor_msgs/Imu stamped ``t_ns`` (frame "imu") with angular velocity ``w`` (3 values, rad/s)."""
+def imu_msg(t_ns: int, w, frame_id: str = FRAME_ID) -> Imu:
+    """A sensor_msgs/Imu stamped ``t_ns`` with angular velocity ``w`` (3 values, rad/s); the synthetic gyro measures
+    in the camera's frame, so its frame is the images' unless told."""
     msg = Imu()
-    stamp_header(msg.header, t_ns, "imu")
+    stamp_header(msg.header, t_ns, frame_id)
     msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in w)
     return msg
 
