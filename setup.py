@@ -12,7 +12,11 @@ import os
 import sys
 from glob import glob
 
+import subprocess
+
 from setuptools import find_packages, setup
+from setuptools.command.develop import develop
+from setuptools.command.install import install
 
 PACKAGE = "iemd_ros"
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -55,8 +59,36 @@ def ros_executables() -> list[str]:
     return paths
 
 
+def compile_kernels(lib_dir: str) -> None:
+    """Fill numba's cache beside the package installed in ``lib_dir`` (``iemd-compile``), so that its first start
+    compiles nothing; a failure only warns (the first start then compiles)."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [lib_dir, os.environ.get("PYTHONPATH")])))
+    result = subprocess.run([sys.executable, "-m", "iemd_ros.apps.compile"], env=env, cwd="/", check=False)
+    if result.returncode != 0:
+        print("warning: iemd-compile failed; the first start will compile the numba kernels", file=sys.stderr)
+
+
+class InstallAndCompile(install):
+    """``setup.py install`` (colcon build), then the kernels; not when staging a wheel (``--root``)."""
+
+    def run(self):
+        super().run()
+        if not self.root:
+            compile_kernels(self.install_lib)
+
+
+class DevelopAndCompile(develop):
+    """``setup.py develop`` (colcon build --symlink-install), then the kernels beside the sources."""
+
+    def run(self):
+        super().run()
+        if not self.uninstall:
+            compile_kernels(HERE)
+
+
 setup(
     name=PACKAGE,
+    cmdclass={"install": InstallAndCompile, "develop": DevelopAndCompile},
     version="0.1.0",
     packages=find_packages(exclude=["test", "test.*"]),
     package_data={"iemd_ros.evaluation": ["split.json"]},
@@ -85,6 +117,7 @@ setup(
             "iemd-make-bag = iemd_ros.apps.make_bag:main",
             "iemd-play = iemd_ros.apps.play:main",
             "iemd-make-lookaway = iemd_ros.apps.make_lookaway:main",
+            "iemd-compile = iemd_ros.apps.compile:main",
         ],
     },
 )

@@ -22,4 +22,5 @@ fi
 bash "$root/scripts/build_interfaces.sh" "$venv"
 echo "[setup] installing iemd_ros into $venv"
 "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-deps --force-reinstall --no-build-isolation .
-"$venv/bin/python" -c "import iemd_ros" 
+# numba's cache beside the installed package: the first start of the node or iemd-replay compiles nothing
+(cd / && "$venv/bin/iemd-compile")

@@ -35,6 +35,7 @@ import threading
 import time
 from collections import deque
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -49,17 +50,48 @@ from iemd_ros.pipeline.watchdog import Abandoned, Watchdog
 from iemd_ros.tracking import IemdTracker
 from iemd_ros.tracking.tracker import warm_up as warm_up_tracker
 
-__all__ = ["TrackingPipeline"]
+__all__ = ["TrackingPipeline", "warm_up_kernels", "kernels_cached", "kernel_cache_dir"]
 
 _WINDOW = 30  # recent frames / IMU messages the diagnostics look at
 
 
+def kernel_cache_dir() -> Path:
+    """Where numba caches the kernels: the ``__pycache__`` folders of the installed package (its root here).
+
+    Returns
+    -------
+    Path
+        The package's folder.
+    """
+    return Path(__file__).resolve().parents[1]
+
+
+def kernels_cached() -> bool:
+    """Whether numba's cache beside the package holds kernels already (else the first pipeline of a process compiles
+    them, 10-30 s).
+
+    Returns
+    -------
+    bool
+        True when a cache index is there.
+    """
+    return any(kernel_cache_dir().glob("*/__pycache__/*.nbi"))
+
+
 @functools.cache
-def _warm_up_once() -> None:
-    """The tracker's and the gyro's numba kernels, compiled once per process at the first pipeline's start-up (not
-    on the first frames)."""
+def warm_up_kernels() -> bool:
+    """The tracker's and the gyro's numba kernels, compiled (or loaded from numba's cache) once per process, at the
+    first pipeline's start-up, not on the first frames.
+
+    Returns
+    -------
+    bool
+        Whether they were in the cache already.
+    """
+    cached = kernels_cached()
     warm_up_tracker()
     warm_up_gyro()
+    return cached
 
 
 def _ms(ns: float) -> str:
@@ -105,7 +137,7 @@ class TrackingPipeline:
     """
 
     def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
-        _warm_up_once()
+        warm_up_kernels()
         self._cfg = config if config is not None else PipelineConfig()
         if not isinstance(self._cfg, PipelineConfig):
             raise ValueError("config must be a PipelineConfig")

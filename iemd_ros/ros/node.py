@@ -64,6 +64,7 @@ from iemd_ros.messages.conversions import (array_to_compressed_fields, bbox_to_b
 from iemd_ros.messages.outputs import bearing_array, detection_array, diagnostic_array, header, image_annotations
 from iemd_ros.pipeline import FrameResult, ImuWait, Level, Part, PipelineConfig, TrackingPipeline, TrackState
 from iemd_ros.pipeline.drawing import box_colour, draw_results
+from iemd_ros.pipeline.pipeline import kernel_cache_dir, kernels_cached
 from iemd_ros.pipeline.topic_status import TopicStatus
 from iemd_ros.ros.extrinsics import TfExtrinsics
 from iemd_ros.ros.messages import RCLPY_MESSAGES
@@ -113,6 +114,10 @@ class _Tracker:
         node = NodeConfig.from_parameters(values)
         self._node_cfg = node
         self._initial_box = self._check_initial_box(node.initial_box)
+        if not kernels_cached():
+            self.get_logger().warning(
+                f"compiling the tracker's numba kernels into {kernel_cache_dir()} (10-30 s, once per install: "
+                f"`iemd-compile` at install time avoids this wait)")
         self.pipeline = TrackingPipeline(cfg)
         self._wait = ImuWait(self.pipeline)
 
