@@ -9,9 +9,10 @@ from helpers import REPO
 
 # Top-level module -> its rosdep key.
 ROSDEP_KEYS = {"cv2": "python3-opencv", "numpy": "python3-numpy", "yaml": "python3-yaml",
-               "matplotlib": "python3-matplotlib", "scipy": "python3-scipy"}
+               "matplotlib": "python3-matplotlib", "scipy": "python3-scipy", "numba": "python3-numba",
+               "rosbags": "python3-rosbags-pip"}
 # Top-level module -> its PyPI distribution (no rosdep key for Jazzy's platforms).
-PIP_ONLY = {"numba": "numba", "ot": "POT", "rosbags": "rosbags"}
+PIP_ONLY = {"ot": "POT"}
 
 
 def _imported_modules() -> set[str]:

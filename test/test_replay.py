@@ -21,7 +21,8 @@ from iemd_ros.common.cli import split_ros_args
 from iemd_ros.evaluation.metrics import iou, score_sequence
 from iemd_ros.apps.replay import main
 from iemd_ros.pipeline import Rejection
-from iemd_ros.bags.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, parse_box, replay
+from iemd_ros.bags.replay import (ANNOTATIONS_TOPIC, CSV_HEADER, DEBUG_IMAGE_TOPIC, DETECTIONS_TOPIC,
+                                  DIAGNOSTICS_TOPIC, parse_box, replay)
 
 N = 10
 BOTH_IMAGE_TYPES = "sensor_msgs/msg/Image or sensor_msgs/msg/CompressedImage"   # as the errors name them
@@ -81,6 +82,20 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
         else:
             assert d.detections == []                          # lost: no detection, as the node
     assert {s.name for s in diags[-1].status} >= {"iemd_tracker: tracking", "iemd_tracker: imu"}
+    # the overlay Foxglove draws (issue #26): an ImageAnnotations per image at its stamp, the box as a closed line
+    # of its corners, and the annotated frame as a JPEG CompressedImage beside it
+    notes, jpegs = by_topic(out, ANNOTATIONS_TOPIC), by_topic(out, DEBUG_IMAGE_TOPIC)
+    assert len(notes) == len(jpegs) == N
+    np.testing.assert_array_equal(stamps(jpegs), seq.frame_stamps_ns)
+    for note, r in zip(notes, rows[1:]):
+        (loop,) = note.points
+        assert loop.timestamp.sec * 10**9 + loop.timestamp.nanosec == int(r[0]) and len(note.texts) == 1
+        x, y, w, h = (float(v) for v in r[1:5])
+        np.testing.assert_allclose([(p.x, p.y) for p in loop.points],
+                                   [(x - .5, y - .5), (x + w - .5, y - .5), (x + w - .5, y + h - .5),
+                                    (x - .5, y + h - .5)], atol=1e-9)
+    assert jpegs[0].format == "bgr8; jpeg compressed bgr8"       # image_transport's compressed naming
+    assert cv2.imdecode(np.asarray(jpegs[0].data, np.uint8), cv2.IMREAD_COLOR).shape == (240, 320, 3)
     cap = cv2.VideoCapture(str(tmp_path / "v.mp4"))
     assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == N and abs(cap.get(cv2.CAP_PROP_FPS) - 30.0) < 0.5
     ok, frame = cap.read()
