@@ -23,6 +23,12 @@ def otb_root() -> Path:
 
 
 @pytest.fixture
+def uav_root() -> Path:
+    """Folder of drone sequences (../shared/data/uav)."""
+    return _need(DATA / "uav")
+
+
+@pytest.fixture
 def car4_first(otb_root):
     """Car4's first frame (BGR) and its ground-truth box (x, y, w, h), the real texture of several tests."""
     from iemd_ros.datasets.otb import load_sequence, read_frame

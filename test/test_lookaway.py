@@ -11,6 +11,7 @@ from iemd_ros.apps.make_lookaway import main as make_main
 from iemd_ros.datasets.lookaway import LookAway, look_away_windows, write_look_away
 from iemd_ros.datasets.otb import Sequence, load_sequence
 from iemd_ros.evaluation.metrics import REACQUIRE_WITHIN, long_term_scores
+from iemd_ros.tracking import IemdTracker
 
 NAN = [np.nan] * 4
 
@@ -91,3 +92,24 @@ def test_eval_reports_the_long_term_measures_of_a_look_away_sequence(tmp_path, c
     lt = doc["results"]["kcf"]["Mover"]["long_term"]
     assert lt["absent_frames"] >= 20 and lt["returns"] == 1 and 0 <= lt["f_score"] <= 1
     assert doc["long_term"]["kcf"]["n_sequences"] == 1 and REACQUIRE_WITHIN == 30
+
+
+def test_the_tracker_says_lost_while_a_real_target_is_away_and_finds_it_on_return(tmp_path, uav_root):
+    """building5 (a drone's view of a walking person) cut into a look-away sequence: the window pans off her for
+    about 30 frames and back.  The tracker reports no box on at least 90 % of the absent frames, is back on her
+    within REACQUIRE_WITHIN frames of her return, and its long-term F-score is at least 0.6 (measured: no report on
+    an absent frame, back at once, F 0.81)."""
+    seq = load_sequence(write_look_away(load_sequence(uav_root / "building5"), tmp_path / "la", LookAway()))
+    frames = [cv2.imread(str(path)) for path in seq.frame_paths]
+    tracker = IemdTracker()
+    tracker.init(frames[0], seq.gt_boxes[0])
+    boxes, ok = [np.asarray(seq.gt_boxes[0], float)], [True]
+    for frame in frames[1:]:
+        result = tracker.update(frame)
+        boxes.append(np.asarray(result.box, float))
+        ok.append(not result.lost)
+    scores = long_term_scores(np.vstack(boxes), np.asarray(ok), seq.gt_boxes)
+    absent = np.isnan(seq.gt_boxes[:, 0])
+    assert absent.sum() >= 25 and np.mean(np.asarray(ok)[absent]) <= 0.1
+    assert scores.reacquired == scores.returns == 1, scores
+    assert scores.f_score >= 0.6, scores

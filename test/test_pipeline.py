@@ -11,6 +11,7 @@ from iemd_ros.pipeline import INIT_REASON, FrameResult, Level, PipelineConfig, R
 
 OK, WARN, ERROR = Level.OK, Level.WARN, Level.ERROR
 from iemd_ros.datasets.synthetic import generate
+from iemd_ros.evaluation.metrics import iou
 from iemd_ros.tracking import IemdTracker, TrackerConfig
 
 N = 24
@@ -98,20 +99,21 @@ def test_no_camera_info_tracks_without_prior_and_warns(seq):
     assert status["imu"].level == WARN and "without the gyro prior" in status["imu"].message
 
 
-def test_gyro_integrates_from_the_last_frame_that_was_not_lost(seq):
+def test_the_gyro_moves_the_lost_window_frame_by_frame(seq):
+    """A lost frame's box is its predicted place (the rotation since the frame before, at that frame's window), and
+    the next frame's prior starts from it: while lost, the window keeps moving with the camera."""
     p, stamps = _started(seq)
     res = {k: p.process(seq.frames[k], stamps[k]) for k in range(1, 6)}
     noise = np.random.default_rng(0).integers(0, 256, seq.frames[6].shape, dtype=np.uint8)
     res[6] = p.process(noise, stamps[6])
-    assert res[6].state is TrackState.LOST and "EMD" in res[6].reason
-    assert p.statuses()[0].level == WARN
+    assert res[6].state is TrackState.LOST and res[6].lost
+    assert p.statuses()[0].level == WARN and "lost for 1 frame(s)" in p.statuses()[0].message
     res[7] = p.process(seq.frames[7], stamps[7])
     ref = GyroPredictor(seq.camera, GyroConfig(time_offset_ns=seq.time_offset_ns))
     ref.add_imu(seq.gyro_t_ns, seq.gyro)
-    right = ref.predict(stamps[5], stamps[7], box=res[5].box).box
-    wrong = ref.predict(stamps[6], stamps[7], box=res[5].box).box
-    np.testing.assert_allclose(res[7].gyro_box, right, atol=1e-9)
-    assert np.hypot(*(box_centre(right) - box_centre(wrong))) > 2.0
+    np.testing.assert_allclose(res[6].gyro_box, ref.predict(stamps[5], stamps[6], box=res[5].box).box, atol=1e-9)
+    np.testing.assert_allclose(res[6].box, res[6].predicted_box, atol=1e-9)
+    np.testing.assert_allclose(res[7].gyro_box, ref.predict(stamps[6], stamps[7], box=res[6].box).box, atol=1e-9)
     assert res[7].state is TrackState.TRACKING
 
 
@@ -385,3 +387,28 @@ def test_extrinsic_from_tf_replaces_the_parameter_and_rebuilds_with_the_samples(
     q, _ = _started(seq)
     q.set_extrinsic(None, "cam", "cam")                          # one frame: nothing to relate, no warning
     assert {s.part.value: s for s in q.statuses()}["imu"].level is Level.OK
+
+
+@pytest.mark.parametrize("use_gyro", [True, False])
+def test_the_camera_turns_away_and_back_the_target_is_found_again(use_gyro):
+    """The synthetic camera turns 60 degrees away from the target for about 1.5 s and back.  With the gyro the lost
+    window's place follows the turn to within 2 % of the image width of the target's true image while it is out of
+    view, and the target is tracked again within 5 frames of its return; without the gyro the re-detection alone
+    finds it within 30 frames (measured: back on the first frame of its return either way, place error 0.0 %)."""
+    seq = generate(motion="turn_away")
+    p = _pipeline(seq, use_gyro=use_gyro)
+    p.set_camera(seq.camera)
+    _feed_imu(p, seq)
+    res = _run(p, seq)
+    width = seq.frames.shape[2]
+    away = np.flatnonzero(~seq.visible[1:])
+    assert len(away) > 30 and all(res[k].lost for k in away[1:-1])  # the first and last overlap the image in part
+    back = away[-1] + 1
+    if use_gyro:
+        errors = [np.hypot(*(box_centre(res[k].box) - seq.gt_centres[k + 1])) / width for k in away]
+        assert max(errors) < 0.02, max(errors)
+    within = 5 if use_gyro else 30
+    overlaps = [float(iou(r.box, seq.gt_boxes[k + 1]).ravel()[0]) if not r.lost else 0.0
+                for k, r in enumerate(res[back:back + within + 10], start=back)]
+    first = next(i for i, v in enumerate(overlaps) if v > 0.5)
+    assert first <= within and min(overlaps[first:]) > 0.5, overlaps

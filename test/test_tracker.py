@@ -279,37 +279,30 @@ def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
     assert offsets[TrackerConfig().motion_weight].max() < 0.3, offsets
 
 
-def test_occlusion_check_holds_the_models_while_a_post_hides_the_runner(otb_root):
-    """Jogging-2 frames 1-75.  Over frames 45-60 the runner passes behind a post.  The occlusion check holds the
-    frames where the filter's response at the window falls (the post in front of her): the window moves but keeps
-    its size, and neither the filters, the colour histograms nor the template learn; she is tracked at frame 75.
-    Held frames are checked against the models' state before them; no frame outside the occlusion is held."""
+def test_a_post_hiding_the_runner_holds_or_loses_her_and_nothing_learns(otb_root):
+    """Jogging-2 frames 1-75.  Over frames 45-60 the runner passes behind a post.  Where the filter's response at
+    the window falls the frame is held (the window moves, keeps its size), where its peak falls further the frame is
+    lost (no box, the window keeps its place); on neither do the filters, the colour histograms or the template
+    learn, each checked against the models' state before the frame.  No frame outside the occlusion and the few frames
+    re-detection takes after it is held or lost, and she is tracked at frame 75."""
     seq = load_sequence("Jogging-2", otb_root)
     frames = [read_frame(path) for path in seq.frame_paths[:76]]
-    default = TrackerConfig().update_confidence
-    assert default > 0
-    overlaps, held = {}, {}
-    for threshold in (0.0, default):
-        tracker = IemdTracker(TrackerConfig(update_confidence=threshold))
-        tracker.init(frames[0], seq.gt_boxes[0])
-        held[threshold] = []
-        for k, frame in enumerate(frames[1:], start=1):
-            before = (tracker._size.copy(), tracker._translation_filter.f.copy(),
-                      tracker._scale_filter.template.copy(), tracker._colour_model._target.copy(),
-                      np.array(tracker.dictionary.templates))
-            result = tracker.update(frame)
-            assert not result.lost
-            if result.held:
-                held[threshold].append(k)
-                after = (tracker._size, tracker._translation_filter.f,
-                         tracker._scale_filter.template, tracker._colour_model._target,
-                         np.array(tracker.dictionary.templates))
-                assert all(np.array_equal(a, b) for a, b in zip(before, after)), k
-                assert result.scale == 1.0 and "models not updated" in result.reason
-        overlaps[threshold] = float(iou(result.box, seq.gt_boxes[75]).ravel()[0])
-    assert held[0.0] == []
-    assert len(held[default]) >= 5 and set(held[default]) <= set(range(44, 62)), held[default]
-    assert overlaps[default] > 0.5, overlaps
+    tracker = IemdTracker()
+    tracker.init(frames[0], seq.gt_boxes[0])
+    held, lost = [], []
+    for k, frame in enumerate(frames[1:], start=1):
+        before = (tracker._size.copy(), tracker._translation_filter.f.copy(), tracker._scale_filter.template.copy(),
+                  tracker._colour_model._target.copy(), np.array(tracker.dictionary.templates))
+        result = tracker.update(frame)
+        if result.held or result.lost:
+            (held if result.held else lost).append(k)
+            after = (tracker._size, tracker._translation_filter.f, tracker._scale_filter.template,
+                     tracker._colour_model._target, np.array(tracker.dictionary.templates))
+            assert all(np.array_equal(a, b) for a, b in zip(before, after)), k
+            assert result.scale == 1.0
+            assert ("models not updated" in result.reason) if result.held else (result.cause is not None)
+    assert len(held + lost) >= 5 and set(held + lost) <= set(range(44, 67)), (held, lost)  # re-found by 66
+    assert not result.lost and iou(result.box, seq.gt_boxes[75]).ravel()[0] > 0.5
 
 
 def test_search_prefers_a_window_the_occlusion_check_accepts(otb_root):
@@ -320,9 +313,10 @@ def test_search_prefers_a_window_the_occlusion_check_accepts(otb_root):
     seq = load_sequence(otb_root / "Woman")
     tracker = IemdTracker()
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
-    overlaps = [float(iou(tracker.update(read_frame(path)).box, seq.gt_boxes[k]).ravel()[0])
-                for k, path in enumerate(seq.frame_paths[1:151], start=1)]
-    assert min(overlaps[139:]) > 0.4, overlaps[120:]
+    results = [tracker.update(read_frame(path)) for path in seq.frame_paths[1:151]]
+    reported = [float(iou(r.box, seq.gt_boxes[k]).ravel()[0]) for k, r in enumerate(results, start=1)
+                if k >= 140 and not r.lost]
+    assert len(reported) >= 8 and min(reported) > 0.4, reported  # no box off her; lost while the car hides her
 
 
 def test_scale_bounds_keep_the_window_between_a_few_pixels_and_the_image():

@@ -93,3 +93,20 @@ def test_the_score_weighs_the_filter_response_against_the_emd(car4_first, monkey
     on_target = np.asarray(box[:2]) + [9.0, -6.0]
     assert np.allclose(results[1e-6].box[:2], on_target, atol=1.5), results[1e-6].box
     assert np.linalg.norm(np.asarray(results[1.0].box[:2]) - on_target) > 20.0, results[1.0].box
+
+
+def test_search_frame_finds_the_target_moved_anywhere_in_a_drone_frame(uav_root):
+    """building5's first 1280x720 frame with the person moved by up to 400 px: the whole-frame search, its strips
+    taken in turn, puts the strongest response within one cell of her (a cell is 4 px of the resampled frame), and
+    its strips cover the frame once."""
+    from iemd_ros.datasets.otb import load_sequence, read_frame
+    seq = load_sequence(uav_root / "building5")
+    frame, box = read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0], float)
+    tf = _learned(frame, box)
+    cell_px = features.CELL * tf._scale(box[2:])
+    for move in [(0.0, 0.0), (400.0, -150.0), (-300.0, -350.0)]:  # she is at (540, 555)
+        moved = shifted(frame, *move)
+        parts = tf.search_frame(moved, box[2:], 0)[2]
+        assert parts > 1  # a 1280x720 frame is searched over several lost frames
+        found = max((tf.search_frame(moved, box[2:], part) for part in range(parts)), key=lambda r: r[1])[0]
+        assert np.linalg.norm(found - (box_centre(box) + move)) < 1.5 * cell_px, (move, found)

@@ -86,7 +86,7 @@ def statuses(d: dict) -> list[Status]:
 
     return [
         Status(Part.TRACKING, *_tracking(d), vals(
-            "state", "targets", "held", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
+            "state", "targets", "held", "emd", "iterations", "lost_run", "lost_s", "frames_lost", "frames_held", "processing_ms_mean",
             "processing_ms_max", "processing_rate_hz", "inits", "resets", "updates_abandoned", "frame_reason")),
         Status(Part.IMAGE, *_image(d), vals(
             "frames_received", "frames_processed", "frames_dropped", "frames_rejected", "images_malformed",
@@ -107,7 +107,7 @@ def _tracking(d: dict) -> tuple[Level, str]:
         return Level.WARN, "no target: set the initial_box parameter or publish on ~/init"
     if d["state"] == "lost":
         level = Level.ERROR if d["lost_run"] >= LOST_ERROR_FRAMES else Level.WARN
-        return level, f"target lost for {d['lost_run']} frame(s): {d['frame_reason']}"
+        return level, f"target lost for {d['lost_run']} frame(s), {d['lost_s']:.2f} s: {d['frame_reason']}"
     return Level.OK, f"tracking (EMD {d['emd']:.4f}, {d['iterations']} iterations)"
 
 

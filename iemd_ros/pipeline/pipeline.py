@@ -16,9 +16,9 @@ Several targets: ``init(frame, box, t_ns, target_id="car")`` adds a target (or r
 and returns one FrameResult per target.  The targets share the IMU buffer, and the gyro rotation between two frames is
 integrated once for all of them (only the local fit of the prior is per box).
 
-Gyro prior (paper, section 5.2): the rotation is integrated from the frame whose window the tracker holds -- the
-init frame or the last frame that was not lost (a lost frame leaves the window where it was) -- to the new frame,
-and the lens-aware ``K R^T K^-1`` prior is fitted at that window.
+Gyro prior (paper, section 5.2): the rotation is integrated from the previous frame the tracker updated on to the
+new frame, and the lens-aware ``K R^T K^-1`` prior is fitted at the window the tracker holds; while the target is
+lost that window is its predicted place, so it keeps moving with the camera, out of the image and back.
 
 Everything that decides a result depends only on the messages (stamps and contents), never on the wall clock, so
 replaying the same messages twice gives identical results; only ``FrameResult.processing_ms`` and the ``*_ms``
@@ -104,9 +104,11 @@ class _Target:
     def __init__(self, target_id: str, tracker: IemdTracker, ref: tuple[int, tuple, np.ndarray]):
         self.id = target_id
         self.tracker = tracker
-        self.ref = ref                      # (stamp, window box, frame) the window is in
+        self.ref = ref                      # (stamp, window box, frame) of the last frame not lost: restarts
+        self.window = ref[:2]               # (stamp, box) the tracker holds, lost or not: the gyro prior's start
         self.state = TrackState.TRACKING
         self.lost_run = 0
+        self.lost_since: int | None = None  # stamp of the first frame of the current lost run
         self.last_result: FrameResult | None = None
 
     def restart(self, config) -> None:
@@ -114,7 +116,7 @@ class _Target:
         _, box, frame = self.ref
         self.tracker = IemdTracker(config)
         self.tracker.init(frame, box)
-        self.state, self.lost_run = TrackState.TRACKING, 0
+        self.state, self.lost_run, self.lost_since, self.window = TrackState.TRACKING, 0, None, self.ref[:2]
 
 
 class TrackingPipeline:
@@ -690,6 +692,7 @@ class TrackingPipeline:
         if exc.ran:
             tracker = IemdTracker(self._cfg.tracker)
             tracker.init(ref_frame, box)
+            target.window = target.ref[:2]
             reason = (f"tracker update abandoned after {self._cfg.watchdog_ms:g} ms (watchdog_ms); the tracker is "
                       f"rebuilt at its window of the frame stamped {t_ref} ns")
         else:
@@ -716,6 +719,7 @@ class TrackingPipeline:
             self._recent_proc.clear()
             for target in self._targets.values():
                 target.ref = (t, target.ref[1], target.ref[2])   # no rotation can be integrated across it
+                target.window = (t, target.window[1])
             newest = self._predictor.buffer.t_newest_ns
             if newest is not None and newest > self._predictor.imu_time(t) + self._cfg.clock_reset_ms * 1e6:
                 self._predictor = self._new_predictor()   # the IMU is still on the old clock
@@ -741,7 +745,7 @@ class TrackingPipeline:
         rotations: dict[int, object] = {}
         out = []
         for target in targets:
-            t_ref, box, _ = target.ref
+            t_ref, box = target.window
             if t == t_ref:
                 out.append((None, None, "frame has the window's own stamp"))
                 continue
@@ -763,12 +767,14 @@ class TrackingPipeline:
         c = self.counters
         c["gyro_used" if gyro_used else "gyro_unused"] += 1
         box = tuple(float(v) for v in result.box)
+        target.window = (t, box)  # lost, the box is the predicted place: the gyro keeps moving it
         if result.lost:
             c["frames_lost"] += 1
             target.lost_run += 1
+            target.lost_since = t if target.lost_since is None else target.lost_since
             target.state = TrackState.LOST
         else:
-            target.lost_run = 0
+            target.lost_run, target.lost_since = 0, None
             target.state = TrackState.TRACKING
             c["frames_held"] += bool(result.held)
             target.ref = (t, box, frame)
@@ -813,6 +819,9 @@ class TrackingPipeline:
             d.update(self._last)
             d["state"] = self._overall_state().value
             d["lost_run"] = min((t.lost_run for t in self._targets.values()), default=0)
+            lost = [t.lost_since for t in self._targets.values() if t.lost_since is not None]
+            d["lost_s"] = ((self._last_stamp - max(lost)) / 1e9 if lost and len(lost) == len(self._targets)
+                           and self._last_stamp is not None else 0.0)
             d["targets"] = ", ".join(f"{t.id or '(default)'}: {t.state.value}" for t in self._targets.values())
             source = ExtrinsicSource.PARAMETER if self._tf_rotation is None else ExtrinsicSource.TF
             imu_frame, camera_frame = self._frames

@@ -12,7 +12,9 @@ Topics (relative names, remap with ``-r image:=/camera/image_raw`` ...):
   optical frame: the unit ray to each target and its angular size, :func:`~iemd_ros.messages.outputs.bearing_array`),
   ``~/annotations`` (foxglove_msgs/ImageAnnotations: the boxes Foxglove's Image panel draws over the image),
   ``/diagnostics`` (diagnostic_msgs/DiagnosticArray), ``~/debug_image`` (annotated bgr8) and
-  ``~/debug_image/compressed`` (the same as JPEG), both drawn only while somebody subscribes.
+  ``~/debug_image/compressed`` (the same as JPEG), both drawn only while somebody subscribes, and ``~/lost``
+  (std_msgs/Bool with every answered frame: true while every target is lost, the cue for a detector to send
+  ``~/init``; /diagnostics says for how long).
 * targets: parameter ``initial_box`` [x, y, w, h] (the target ``detection_id``, applied to the next frame), topic
   ``~/init`` (vision_msgs/Detection2D: adds the target of its ``id``, or restarts the one with that id; an empty id
   is ``detection_id``; its header stamp picks the frame from a ring buffer of recent frames, a zero stamp means the
@@ -52,7 +54,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter as RclpyParameter
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
-from std_msgs.msg import String
+from std_msgs.msg import Bool, String
 from std_srvs.srv import Trigger
 from vision_msgs.msg import Detection2D, Detection2DArray, Detection3DArray
 
@@ -149,6 +151,7 @@ class _Tracker:
         self._annotation_pub = make_publisher(ImageAnnotations, "~/annotations", 10)
         self._debug_pub = make_publisher(Image, "~/debug_image", 1)
         self._debug_jpeg_pub = make_publisher(CompressedImage, "~/debug_image/compressed", 1)
+        self._lost_pub = make_publisher(Bool, "~/lost", 10)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
         image_sub = self._subscribe_image(node.image_transport, sensor_qos)
         self._image_topic = image_sub.topic_name  # after remapping
@@ -161,7 +164,7 @@ class _Tracker:
             self.create_service(Trigger, "~/reset", self._on_reset),
             self.create_timer(node.diagnostics_period_s, self._publish_diagnostics)]
         self._outputs = [self._det_pub, self._bearing_pub, self._annotation_pub, self._debug_pub,
-                         self._debug_jpeg_pub]
+                         self._debug_jpeg_pub, self._lost_pub]
         self._extrinsics = TfExtrinsics(self, self._warn)
 
         self._worker = threading.Thread(target=self._work, name="iemd_tracker_worker", daemon=True)
@@ -479,6 +482,7 @@ class _Tracker:
         if self._stop or not self._active or not self.context.ok():
             return
         self._det_pub.publish(out)
+        self._lost_pub.publish(Bool(data=self.pipeline.state is TrackState.LOST))  # what a detector acts on
         self._bearing_pub.publish(bearings)
         self._annotation_pub.publish(annotations)
         self._output_status.tick(time.monotonic(), (self.get_clock().now().nanoseconds - stamp_ns(img.header)) / 1e9,

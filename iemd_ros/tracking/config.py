@@ -82,6 +82,10 @@ class TrackerConfig:
                                    range=(0.0, 10.0), decision="particles")
     particle_trigger: float = param(0.85, "search the particles when EMD > this x background EMD (0: always)",
                                     range=(0.0, 100.0), decision="background-emd")
+    lost_response: float = param(0.5, "lost when the filter's peak near the prediction falls below this times its "
+                                 "running mean (0: never)", range=(0.0, 0.99), decision="re-detection")
+    found_response: float = param(1.0, "while lost, a re-detected window is taken when the filter's peak there "
+                                  "reaches this times its running mean", range=(0.01, 10.0), decision="re-detection")
     lost_factor: float = param(1.0, "lost when EMD > this x the background EMD measured at init",
                                range=(0.01, 100.0), decision="background-emd")
     min_visible: float = param(0.25, "lost when less of the window than this is inside the image", range=(0.0, 1.0))

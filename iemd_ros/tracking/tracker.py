@@ -31,6 +31,7 @@ __all__ = ["IemdTracker", "TrackResult", "Cause", "warm_up"]
 
 MIN_SIDE_PX = 4.0  # the scale search never shrinks a window's shorter side below this (image pixels)
 CONFIDENCE_RATE = 0.1  # learning rate of the running mean that update_confidence compares the response with
+FRAME_SEARCH_AFTER = 5  # lost frames searched only around the prediction before the whole frame is searched too
 
 
 class Cause(enum.Enum):
@@ -39,6 +40,8 @@ class Cause(enum.Enum):
     OUT_OF_VIEW = "out of view"                          # too little of the window inside the image
     EMD_ABOVE_BACKGROUND = "EMD above the background's"  # the window no longer looks like the target
     LOW_RESPONSE = "low filter response"                 # held: the occlusion check
+    NO_PEAK = "no filter peak"                           # the filter's peak far below its running mean
+    REDETECTED = "re-detected"                           # found again while lost (not learned from)
 
 
 @dataclass
@@ -156,6 +159,8 @@ class IemdTracker:
         self._frame_index = 0
         self._lost = False
         self._confidence = None  # running mean of the filter's response at the window over frames that learned
+        self._search_part = 0  # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
+        self._lost_frames = 0  # lost frames in a row
 
     def update(self, frame: np.ndarray, prior=None) -> TrackResult:
         """Track the target into ``frame``.
@@ -192,20 +197,25 @@ class IemdTracker:
         previous, grey, pyramid = self._take_frame(frame)
         visible = _visible_fraction(center, size, angle, frame.shape)
         if visible < self.config.min_visible:  # the prior moved the window out of view: keep its place, search nothing
-            self._center, self._size, self._angle, self._lost = center, size, angle, True
-            return TrackResult(box=predicted, emd=float("inf"), iterations=0, lost=True, angle=angle, starts=0,
-                               predicted_box=predicted, cause=Cause.OUT_OF_VIEW,
-                               reason=f"only {visible:.0%} of the predicted window is inside the image")
+            return self._lose(center, size, angle, predicted, Cause.OUT_OF_VIEW,
+                              f"only {visible:.0%} of the predicted window is inside the image")
+        if self._lost and self._translation_filter is not None:
+            return self._redetect(frame, pyramid, center, size, angle, predicted)
         best, searches, starts = self._search_all(frame, previous, grey, pyramid, prior, center, size, angle)
         final, scale = _Descent(model=best.model, emd=best.emd), 1.0  # a held frame keeps the window's size
         if not best.held_reason:
             final, scale = self._estimate_scale(frame, best, _scale_bounds(best.model.size, frame.shape))
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
         cause, reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
-        lost = self._lost = cause is not None
-        held = bool(best.held_reason) and not lost
-        if not lost:
-            self._center, self._size, self._angle = new_center, new_size, angle
+        if cause is None:
+            cause, reason = self._peak_check()
+        if cause is not None:
+            return self._lose(center, size, angle, predicted, cause, reason, emd=emd, searched=best,
+                              starts=starts, codings=sum(s.codings for s in searches) + final.codings)
+        lost = self._lost = False
+        self._lost_frames = 0
+        held = bool(best.held_reason)
+        self._center, self._size, self._angle = new_center, new_size, angle
         if not lost and not held:
             self._learn(frame, final, best.confidence, new_center, new_size, angle)
         if held:
@@ -218,6 +228,54 @@ class IemdTracker:
         )
 
     # ------------------------------------------------------------ internals
+    def _lose(self, center, size, angle, predicted, cause: Cause, reason: str, emd: float = float("inf"),
+              searched: _Descent | None = None, starts: int = 0, codings: int = 0) -> TrackResult:
+        """The lost frame's result; the window keeps its predicted place (it moves with the prior while lost)."""
+        self._center, self._size, self._angle, self._lost = center, size, angle, True
+        self._lost_frames += 1
+        return TrackResult(box=predicted, emd=emd, iterations=searched.iterations if searched else 0, lost=True,
+                           angle=angle, starts=starts, codings=codings, predicted_box=predicted, reason=reason,
+                           cause=cause)
+
+    def _peak_check(self) -> tuple[Cause | None, str]:
+        """(NO_PEAK, reason) when the translation filter's peak near the prediction is below ``lost_response``
+        times the running mean of its response on learned frames (LCT's re-detection trigger), else (None, "")."""
+        if self._translation_filter is None or self._confidence is None:
+            return None, ""
+        peak = self._translation_filter.confidence["peak"]
+        if peak >= self.config.lost_response * self._confidence:
+            return None, ""
+        return Cause.NO_PEAK, (f"filter peak {peak:.3f} < {self.config.lost_response} x its running mean "
+                               f"{self._confidence:.3f}")
+
+    def _redetect(self, frame, pyramid, center, size, angle, predicted) -> TrackResult:
+        """A lost frame: the filter searched around the prediction, then, after ``FRAME_SEARCH_AFTER`` lost frames
+        (a short loss is found near where it happened), one strip of the whole frame (a scan of the frame spread over
+        lost frames); the best peak is taken when it reaches ``found_response`` times the running
+        mean and its window's EMD is below the lost limit.  Nothing learns from the frame."""
+        tf, cfg = self._translation_filter, self.config
+        found = center + tf.estimate(frame, center, size, angle)
+        peak, starts = tf.confidence["peak"], 1
+        if peak < cfg.found_response * self._confidence and self._lost_frames >= FRAME_SEARCH_AFTER:
+            coarse, _, parts = tf.search_frame(frame, size, self._search_part)
+            self._search_part = (self._search_part + 1) % parts
+            refined = coarse + tf.estimate(frame, coarse, size, angle)
+            starts += 1
+            if tf.confidence["peak"] > peak:
+                found, peak = refined, tf.confidence["peak"]
+        if peak < cfg.found_response * self._confidence:
+            return self._lose(center, size, angle, predicted, Cause.NO_PEAK,
+                              f"searching: best filter peak {peak:.3f} < {cfg.found_response} x its running mean "
+                              f"{self._confidence:.3f}", starts=starts)
+        emd = CandidateModel(self._context(pyramid, angle), found, size).emd()[0]
+        cause, reason = self._lost_reason(emd, found, size, angle, frame.shape)
+        if cause is not None:
+            return self._lose(center, size, angle, predicted, cause, reason, emd=emd, starts=starts, codings=1)
+        self._center, self._size, self._angle, self._lost, self._lost_frames = found, size, angle, False, 0
+        return TrackResult(box=_box(found, size, angle), emd=emd, iterations=0, lost=False, angle=angle,
+                           starts=starts, codings=1, predicted_box=predicted, cause=Cause.REDETECTED,
+                           reason=f"re-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean")
+
     def _search_all(self, frame, previous, grey, pyramid, prior, center, size, angle):
         """(best descent, every search run, starts searched) from the prediction ``center``: the fine starts
         (flow, translation filter, colour model) and, when the frame looks lost, section 6.1's particles."""

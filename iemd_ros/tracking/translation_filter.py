@@ -22,6 +22,7 @@ filter trained on the target against its own surroundings is the complementary v
 """
 from __future__ import annotations
 
+import cv2
 import numba
 import numpy as np
 import scipy.fft as sfft
@@ -40,6 +41,7 @@ REG_TARGET, REG_BACKGROUND = 1e-3, 1e5        # BACF's binary spatial regulariza
 MU = 15.0                                     # STRCF's temporal regularization
 ADMM_ITERATIONS = 2
 GAMMA_INIT, GAMMA_STEP, GAMMA_MAX = 1.0, 10.0, 0.1  # ADMM penalty schedule (STRCF)
+FRAME_SEARCH_CELLS = 2048  # feature cells searched per search_frame call (its cost per lost frame)
 
 
 class TranslationFilter:
@@ -52,6 +54,7 @@ class TranslationFilter:
     def __init__(self):
         self.f = None
         self._detection = self._response = None
+        self._frame_filter = None  # (f, shape, its conjugate spectrum at that shape) for search_frame
         self.confidence = {}
 
     def init(self, frame: np.ndarray, center, size, colour: bool, angle: float = 0.0) -> None:
@@ -134,6 +137,57 @@ class TranslationFilter:
         resp, pos, cell_px, axes = self._response
         d = axes.T @ (np.asarray(point, dtype=np.float64) - pos) / cell_px
         return _bilinear_circular(resp, float(d[1]), float(d[0]))
+
+    def search_frame(self, frame: np.ndarray, size, part: int = 0) -> tuple[np.ndarray, float, int]:
+        """Where in one part of ``frame`` the filter responds most, at the scale of a window of ``size``.
+
+        The frame is resampled to the filter's scale and cut into vertical strips of at most
+        ``FRAME_SEARCH_CELLS`` feature cells; the strip's features are correlated with the spatial filter,
+        zero-padded so that the correlation is linear, not circular (the strip is read with a margin of half the
+        filter on each side).  A caller scans the whole frame by asking for parts 0, 1, ... over several frames.
+
+        Parameters
+        ----------
+        frame : ndarray
+            The frame.
+        size : array_like
+            The window's size (w, h), px: the scale the frame is resampled to.
+        part : int
+            Which strip (taken modulo the number of strips).
+
+        Returns
+        -------
+        centre : ndarray
+            (cx, cy) of the strongest response in the strip, image px (pixel centres at integers).
+        response : float
+            The response there (no cosine window, so not comparable with :attr:`confidence`: check a candidate
+            with :meth:`estimate`).
+        parts : int
+            How many strips the frame has at this scale.
+        """
+        scale = self._scale(size)
+        rows, cols = frame.shape[:2]
+        cells = (max(int(rows / (features.CELL * scale)), 1), max(int(cols / (features.CELL * scale)), 1))
+        parts = max(int(np.ceil(cells[0] * cells[1] / FRAME_SEARCH_CELLS)), 1)
+        width = int(np.ceil(cells[1] / parts))
+        parts = int(np.ceil(cells[1] / width))  # no empty last strip
+        n, c0 = self.map_hw[0], self.map_hw[0] // 2  # a target at cell k answers at displacement k - c0
+        first = (part % parts) * width
+        lo, hi = max(first - c0, 0), min(first + width + c0, cells[1])
+        ratio = np.array([cols / (cells[1] * features.CELL), rows / (cells[0] * features.CELL)])
+        strip = sample_region(frame, ((lo + hi) * features.CELL / 2 * ratio[0] - 0.5, rows / 2 - 0.5),
+                              ((hi - lo) * features.CELL * ratio[0], rows), ((hi - lo) * features.CELL,
+                                                                            cells[0] * features.CELL))
+        z = features.extract(strip, self.colour)
+        shape = (cells[0] + n, hi - lo + n)
+        if self._frame_filter is None or self._frame_filter[0] is not self.f or self._frame_filter[1] != shape:
+            h = sfft.irfft2(self.f, s=self.map_hw, axes=(1, 2))  # the spatial filter, the target at the centre cell
+            self._frame_filter = (self.f, shape, np.conj(sfft.rfft2(h, s=shape, axes=(1, 2))))
+        resp_f = np.sum(self._frame_filter[2] * sfft.rfft2(z, s=shape, axes=(1, 2)), axis=0)
+        resp = np.roll(sfft.irfft2(resp_f, s=shape), (c0, c0), axis=(0, 1))[:cells[0], first - lo:first - lo + width]
+        k = np.unravel_index(int(np.argmax(resp)), resp.shape)
+        centre = (np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5) * features.CELL * ratio - 0.5
+        return centre, float(resp[k]), parts
 
     # ------------------------------------------------------------------ learning
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
