@@ -33,9 +33,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from iemd_ros.bags.io import BagError, BagMessages, BagWriter, Progress, Topics, deserialize, iter_messages, \
-    open_bag, select_topics
+from iemd_ros.bags.io import BagError, BagMessages, BagWriter, Topics, deserialize, iter_messages, open_bag, \
+    select_topics
 from iemd_ros.common.boxes import check_box
+from iemd_ros.common.progress import Progress
 from iemd_ros.gyro import CameraModel
 from iemd_ros.messages.conversions import CLASS_ID, DETECTION_ID, camera_model_from_msg, image_from_msg, \
     imu_sample, stamp_ns
