@@ -65,3 +65,14 @@ def stop_process():
             return out, err, False
 
     return stop
+
+
+@pytest.fixture(scope="session")
+def dask_cluster() -> str:
+    """The address of a Dask distributed cluster on this machine only: a scheduler and 2 single-thread worker
+    processes on 127.0.0.1, started here and closed at the end of the session."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
+                      dashboard_address=None, memory_limit="4GiB") as cluster:
+        yield cluster.scheduler_address
