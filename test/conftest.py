@@ -70,9 +70,10 @@ def stop_process():
 @pytest.fixture(scope="session")
 def dask_cluster() -> str:
     """The address of a Dask distributed cluster on this machine only: a scheduler and 2 single-thread worker
-    processes on 127.0.0.1, started here and closed at the end of the session."""
+    processes on 127.0.0.1, started here and closed at the end of the session.  Every port is a free one on the
+    loopback (the scheduler's HTTP server listens even without a dashboard: on 127.0.0.1 too)."""
     from distributed import LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
-                      dashboard_address=None, memory_limit="4GiB") as cluster:
+                      dashboard_address="127.0.0.1:0", memory_limit="4GiB") as cluster:
         yield cluster.scheduler_address
