@@ -1,0 +1,66 @@
+"""``iemd-eval`` serially, on N local processes and on a local Dask cluster of N workers, in one run: the wall
+time of each and the digest of its ``results.json`` without the wall-clock fields (the three must be equal).
+
+    python benchmarks/eval_scale.py [--workers 2] [--out DIR] [-- iemd-eval arguments ...]
+
+Each run is the command ``python -m iemd_ros.apps.eval ARGS --out DIR/<run> (--jobs 1 | --jobs N | --cluster A)``
+in its own process, timed from its start to its end.  The cluster is a ``distributed.LocalCluster`` of N
+single-thread worker processes on 127.0.0.1, started by this script before its run (its start-up is printed
+apart) and closed after it.  Without iemd-eval arguments every sequence of ../shared/data/otb and uav runs with
+the default trackers.  Prints the commands, then one row per run: wall time, speed-up over the serial run,
+digest (:func:`iemd_ros.evaluation.ope.results_digest`).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from iemd_ros.evaluation.ope import WALL_CLOCK_FIELDS, results_digest
+
+
+def _run(name: str, args: list[str], where: list[str], out: Path) -> tuple[float, str]:
+    cmd = [sys.executable, "-m", "iemd_ros.apps.eval", *args, "--out", str(out / name), *where]
+    print(f"[{name}] {' '.join(cmd)}", flush=True)
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - t0
+    if proc.returncode != 0:
+        sys.exit(f"eval_scale: the {name} run failed ({proc.returncode}): {proc.stderr.strip()[-500:]}")
+    return wall, results_digest(json.loads((out / name / "results.json").read_text()))
+
+
+def main() -> int:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--workers", type=int, default=2, help="local processes and cluster workers (default 2)")
+    p.add_argument("--out", type=Path, default=None, help="where the three runs write (default: a temporary folder)")
+    p.add_argument("eval_args", nargs=argparse.REMAINDER, help="arguments of iemd-eval, after --")
+    a = p.parse_args()
+    args = [x for x in a.eval_args if x != "--"]
+    out = a.out or Path(tempfile.mkdtemp(prefix="eval_scale_"))
+    rows = [("serial", *_run("serial", args, ["--jobs", "1"], out)),
+            (f"{a.workers} processes", *_run("local", args, ["--jobs", str(a.workers)], out))]
+    from distributed import LocalCluster
+
+    t0 = time.perf_counter()
+    with LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
+                      dashboard_address="127.0.0.1:0") as cluster:
+        started = time.perf_counter() - t0
+        print(f"[cluster] LocalCluster of {a.workers} workers at {cluster.scheduler_address}, up in {started:.1f} s")
+        rows.append((f"Dask, {a.workers} workers", *_run("cluster", args, ["--cluster", cluster.scheduler_address], out)))
+    serial = rows[0][1]
+    print(f"\nresults in {out}; digest of results.json without {', '.join(WALL_CLOCK_FIELDS)}")
+    print(f"{'run':<18} {'wall s':>8} {'speed-up':>9}  digest")
+    for name, wall, digest in rows:
+        print(f"{name:<18} {wall:8.1f} {serial / wall:8.2f}x  {digest}")
+    same = len({digest for _, _, digest in rows}) == 1
+    print("identical results" if same else "RESULTS DIFFER")
+    return 0 if same else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
