@@ -6,7 +6,8 @@ time of each and the digest of its ``results.json`` without the wall-clock field
 Each run is the command ``python -m iemd_ros.apps.eval ARGS --out DIR/<run> (--jobs 1 | --jobs N | --cluster A)``
 in its own process, timed from its start to its end.  The cluster is a ``distributed.LocalCluster`` of N
 single-thread worker processes on 127.0.0.1, started by this script before its run (its start-up is printed
-apart) and closed after it.  Without iemd-eval arguments every sequence of ../shared/data/otb and uav runs with
+apart) and closed after it.  Beside the wall time: the CPU seconds of each run (the command's and its workers',
+the cluster's start and stop included) and the machine's load average, since other jobs share the cores.  Without iemd-eval arguments every sequence of ../shared/data/otb and uav runs with
 the default trackers.  Prints the commands, then one row per run: wall time, speed-up over the serial run,
 digest (:func:`iemd_ros.evaluation.ope.results_digest`).
 """
@@ -14,6 +15,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -23,7 +26,14 @@ from pathlib import Path
 from iemd_ros.evaluation.ope import WALL_CLOCK_FIELDS, results_digest
 
 
-def _run(name: str, args: list[str], where: list[str], out: Path) -> tuple[float, str]:
+def _cpu_s() -> float:
+    """CPU seconds (user + system) of this process and of its children waited for."""
+    return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
+                                                 resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+
+def _run(name: str, args: list[str], where: list[str], out: Path) -> tuple[float, float, str]:
+    """Wall time, the load average over the last minute at the end, and the digest of one run."""
     cmd = [sys.executable, "-m", "iemd_ros.apps.eval", *args, "--out", str(out / name), *where]
     print(f"[{name}] {' '.join(cmd)}", flush=True)
     t0 = time.perf_counter()
@@ -31,7 +41,26 @@ def _run(name: str, args: list[str], where: list[str], out: Path) -> tuple[float
     wall = time.perf_counter() - t0
     if proc.returncode != 0:
         sys.exit(f"eval_scale: the {name} run failed ({proc.returncode}): {proc.stderr.strip()[-500:]}")
-    return wall, results_digest(json.loads((out / name / "results.json").read_text()))
+    return wall, os.getloadavg()[0], results_digest(json.loads((out / name / "results.json").read_text()))
+
+
+def _timed(run) -> tuple[float, float, str, float]:
+    """``run()``'s figures and the CPU seconds spent meanwhile by this process and its children."""
+    cpu = _cpu_s()
+    figures = run()
+    return (*figures, _cpu_s() - cpu)
+
+
+def _on_cluster(workers: int, args: list[str], out: Path) -> tuple[float, float, str]:
+    """The run on a LocalCluster started (its start-up printed) and closed here."""
+    from distributed import LocalCluster
+
+    t0 = time.perf_counter()
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
+                      dashboard_address="127.0.0.1:0") as cluster:
+        print(f"[cluster] LocalCluster of {workers} workers at {cluster.scheduler_address}, up in "
+              f"{time.perf_counter() - t0:.1f} s")
+        return _run("cluster", args, ["--cluster", cluster.scheduler_address], out)
 
 
 def main() -> int:
@@ -42,22 +71,17 @@ def main() -> int:
     a = p.parse_args()
     args = [x for x in a.eval_args if x != "--"]
     out = a.out or Path(tempfile.mkdtemp(prefix="eval_scale_"))
-    rows = [("serial", *_run("serial", args, ["--jobs", "1"], out)),
-            (f"{a.workers} processes", *_run("local", args, ["--jobs", str(a.workers)], out))]
-    from distributed import LocalCluster
-
-    t0 = time.perf_counter()
-    with LocalCluster(n_workers=a.workers, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
-                      dashboard_address="127.0.0.1:0") as cluster:
-        started = time.perf_counter() - t0
-        print(f"[cluster] LocalCluster of {a.workers} workers at {cluster.scheduler_address}, up in {started:.1f} s")
-        rows.append((f"Dask, {a.workers} workers", *_run("cluster", args, ["--cluster", cluster.scheduler_address], out)))
+    rows = [("serial", *_timed(lambda: _run("serial", args, ["--jobs", "1"], out))),
+            (f"{a.workers} processes", *_timed(lambda: _run("local", args, ["--jobs", str(a.workers)], out)))]
+    rows.append((f"Dask, {a.workers} workers", *_timed(lambda: _on_cluster(a.workers, args, out))))
     serial = rows[0][1]
-    print(f"\nresults in {out}; digest of results.json without {', '.join(WALL_CLOCK_FIELDS)}")
-    print(f"{'run':<18} {'wall s':>8} {'speed-up':>9}  digest")
-    for name, wall, digest in rows:
-        print(f"{name:<18} {wall:8.1f} {serial / wall:8.2f}x  {digest}")
-    same = len({digest for _, _, digest in rows}) == 1
+    print(f"\nresults in {out}; digest of results.json without {', '.join(WALL_CLOCK_FIELDS)}; load: the machine's "
+          "1-minute load average at the end of the run; cpu s: of the command and its workers (the cluster's "
+          "included)")
+    print(f"{'run':<18} {'wall s':>8} {'speed-up':>9} {'load':>5} {'cpu s':>7}  digest")
+    for name, wall, load, digest, cpu in rows:
+        print(f"{name:<18} {wall:8.1f} {serial / wall:8.2f}x {load:5.1f} {cpu:7.1f}  {digest}")
+    same = len({row[3] for row in rows}) == 1
     print("identical results" if same else "RESULTS DIFFER")
     return 0 if same else 1
 
