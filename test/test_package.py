@@ -10,8 +10,9 @@ from helpers import REPO
 # Top-level module -> its rosdep key.
 ROSDEP_KEYS = {"cv2": "python3-opencv", "numpy": "python3-numpy", "yaml": "python3-yaml",
                "matplotlib": "python3-matplotlib"}
-# Top-level module -> its PyPI distribution (no rosdep key for Jazzy's platforms).
-PIP_ONLY = {"numba": "numba", "ot": "POT", "rosbags": "rosbags"}
+# Top-level module -> its PyPI distribution (no rosdep key for Jazzy's platforms; distributed is imported only by
+# --cluster, iemd_ros.common.parallel).
+PIP_ONLY = {"numba": "numba", "ot": "POT", "rosbags": "rosbags", "distributed": "distributed"}
 
 
 def _imported_modules() -> set[str]:
