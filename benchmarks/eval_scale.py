@@ -6,10 +6,12 @@ time of each and the digest of its ``results.json`` without the wall-clock field
 Each run is the command ``python -m iemd_ros.apps.eval ARGS --out DIR/<run> (--jobs 1 | --jobs N | --cluster A)``
 in its own process, timed from its start to its end.  The cluster is a ``distributed.LocalCluster`` of N
 single-thread worker processes on 127.0.0.1, started by this script before its run (its start-up is printed
-apart) and closed after it.  Beside the wall time: the CPU seconds of each run (the command's and its workers',
-the cluster's start and stop included) and the machine's load average, since other jobs share the cores.  Without iemd-eval arguments every sequence of ../shared/data/otb and uav runs with
-the default trackers.  Prints the commands, then one row per run: wall time, speed-up over the serial run,
-digest (:func:`iemd_ros.evaluation.ope.results_digest`).
+apart) and closed after it; its workers start as the README advises (``DASK_WORKER_CONFIG``;
+``--dask-defaults``: with Dask's defaults).  Beside the wall time: the CPU seconds of each run (the command's and
+its workers', the cluster's start and stop included) and the machine's load average, since other jobs share the
+cores.  Without iemd-eval arguments every sequence of ../shared/data/otb and uav runs with the default trackers.
+Prints the commands, then one row per run: wall time, speed-up over the serial run, load, CPU seconds, digest
+(:func:`iemd_ros.evaluation.ope.results_digest`).
 """
 from __future__ import annotations
 
@@ -23,6 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
+from iemd_ros.common.parallel import DASK_WORKER_CONFIG
 from iemd_ros.evaluation.ope import WALL_CLOCK_FIELDS, results_digest
 
 
@@ -51,13 +54,16 @@ def _timed(run) -> tuple[float, float, str, float]:
     return (*figures, _cpu_s() - cpu)
 
 
-def _on_cluster(workers: int, args: list[str], out: Path) -> tuple[float, float, str]:
-    """The run on a LocalCluster started (its start-up printed) and closed here."""
+def _on_cluster(workers: int, args: list[str], out: Path, trim_off: bool) -> tuple[float, float, str]:
+    """The run on a LocalCluster started (its start-up printed) and closed here; ``trim_off``: its workers started
+    with :data:`~iemd_ros.common.parallel.DASK_WORKER_CONFIG`."""
+    import dask
     from distributed import LocalCluster
 
     t0 = time.perf_counter()
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
-                      dashboard_address="127.0.0.1:0") as cluster:
+    with dask.config.set(DASK_WORKER_CONFIG if trim_off else {}), LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
+            dashboard_address="127.0.0.1:0") as cluster:
         print(f"[cluster] LocalCluster of {workers} workers at {cluster.scheduler_address}, up in "
               f"{time.perf_counter() - t0:.1f} s")
         return _run("cluster", args, ["--cluster", cluster.scheduler_address], out)
@@ -67,13 +73,16 @@ def main() -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--workers", type=int, default=2, help="local processes and cluster workers (default 2)")
     p.add_argument("--out", type=Path, default=None, help="where the three runs write (default: a temporary folder)")
+    p.add_argument("--dask-defaults", action="store_true",
+                   help="start the cluster's workers with Dask's defaults (MALLOC_TRIM_THRESHOLD_ set), not as the "
+                        "README advises (DASK_WORKER_CONFIG)")
     p.add_argument("eval_args", nargs=argparse.REMAINDER, help="arguments of iemd-eval, after --")
     a = p.parse_args()
     args = [x for x in a.eval_args if x != "--"]
     out = a.out or Path(tempfile.mkdtemp(prefix="eval_scale_"))
     rows = [("serial", *_timed(lambda: _run("serial", args, ["--jobs", "1"], out))),
             (f"{a.workers} processes", *_timed(lambda: _run("local", args, ["--jobs", str(a.workers)], out)))]
-    rows.append((f"Dask, {a.workers} workers", *_timed(lambda: _on_cluster(a.workers, args, out))))
+    rows.append((f"Dask, {a.workers} workers", *_timed(lambda: _on_cluster(a.workers, args, out, not a.dask_defaults))))
     serial = rows[0][1]
     print(f"\nresults in {out}; digest of results.json without {', '.join(WALL_CLOCK_FIELDS)}; load: the machine's "
           "1-minute load average at the end of the run; cpu s: of the command and its workers (the cluster's "

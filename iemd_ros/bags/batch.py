@@ -124,7 +124,7 @@ def run_replay_job(job: ReplayJob) -> ReplayResult:
     Returns
     -------
     ReplayResult
-        The results and the run's statistics.
+        What :func:`~iemd_ros.bags.replay.replay` returns.
 
     Raises
     ------

@@ -26,10 +26,13 @@ from dataclasses import dataclass
 
 from iemd_ros.common.progress import Progress
 
-__all__ = ["InlineExecutor", "Workers", "add_worker_arguments", "local_cores", "run_jobs"]
+__all__ = ["DASK_WORKER_CONFIG", "InlineExecutor", "Workers", "add_worker_arguments", "local_cores", "run_jobs"]
 
 #: jobs kept submitted per local worker process (one running, one queued in the pool)
 WINDOW_PER_WORKER = 2
+#: Dask configuration for the nannies that start a cluster's workers: no ``MALLOC_TRIM_THRESHOLD_`` (Dask's default
+#: sets it, which turns every image-sized temporary into an mmap and its page faults; docs/decisions.md#parallel-engine)
+DASK_WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
 
 
 def local_cores() -> int:
@@ -93,12 +96,12 @@ class Workers:
         return 0 if self.cluster is not None else max(min(self.jobs or local_cores(), n_jobs), 1)
 
     def describe(self, n_jobs: int) -> str:
-        """Where ``n_jobs`` jobs run, for the commands' first line.
+        """Where ``n_jobs`` jobs run (:meth:`processes`), in words for the commands' first line.
 
         Parameters
         ----------
         n_jobs : int
-            The number of jobs.
+            As :meth:`processes` takes it.
 
         Returns
         -------
