@@ -81,6 +81,7 @@ setup(
             "iemd-replay = iemd_ros.apps.replay:main",
             "iemd-make-bag = iemd_ros.apps.make_bag:main",
             "iemd-play = iemd_ros.apps.play:main",
+            "iemd-make-lookaway = iemd_ros.apps.make_lookaway:main",
         ],
     },
 )

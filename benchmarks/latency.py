@@ -16,7 +16,8 @@ to the arrival of the Detection2DArray carrying its stamp (both on the driver's 
 Peer, measured in the same run and setup: an echo node that answers each image with an empty
 Detection2DArray at once (transport + rclpy overhead only).  Frames the tracker drops as stale (it
 keeps up with the newest frame) get no answer: "answered" is the fraction of published frames with
-a detection, "delivered" the fraction that reached the node (from its /diagnostics counters).
+a detection array, "delivered" the fraction that reached the node, "processed" and "dropped" the tracker's own
+counts (from its /diagnostics counters).  ``--rate 60`` gives more frames than the tracker can process.
 """
 from __future__ import annotations
 
@@ -204,7 +205,8 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     return dict(setup=setup, subject=subject, answered=len(lat) / n, delivered=delivered,
                 p50=float(np.percentile(lat, 50)) if len(lat) else float("nan"),
                 p95=float(np.percentile(lat, 95)) if len(lat) else float("nan"),
-                proc=float(diag.get("tracking.processing_ms_mean", "nan")))
+                proc=float(diag.get("tracking.processing_ms_mean", "nan")), sent=len(sent),
+                processed=int(diag.get("frames_processed", -1)), dropped=int(diag.get("frames_dropped", -1)))
 
 
 def main(argv=None) -> int:
@@ -234,7 +236,7 @@ def main(argv=None) -> int:
     print(f"{args.frames} frames {args.width}x{args.height} bgr8 at {args.rate:.0f} Hz, "
           f"{'reliable' if args.reliable else 'sensor-data (best effort)'} QoS")
     print(f"{'setup':12s} {'subject':8s} {'delivered':>9s} {'answered':>8s} {'p50 ms':>7s} {'p95 ms':>7s} "
-          f"{'track ms':>8s}")
+          f"{'track ms':>8s} {'sent':>5s} {'processed':>9s} {'dropped':>7s}")
     rows = []
     for setup in args.setups.split(","):
         for subject in args.subjects.split(","):
@@ -252,8 +254,9 @@ def main(argv=None) -> int:
                 return 1
             r = json.loads(lines[-1][7:])
             rows.append(r)
+            counted = (f"{r['processed']:9d} {r['dropped']:7d}" if subject == "tracker" else f"{'':9s} {'':7s}")
             print(f"{setup:12s} {subject:8s} {r['delivered']:9.0%} {r['answered']:8.0%} {r['p50']:7.1f} "
-                  f"{r['p95']:7.1f} {r['proc']:8.1f}", flush=True)
+                  f"{r['p95']:7.1f} {r['proc']:8.1f} {r['sent']:5d} {counted}", flush=True)
     for setup in args.setups.split(","):
         pair = {r["subject"]: r for r in rows if r["setup"] == setup}
         if len(pair) < 2:

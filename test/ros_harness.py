@@ -182,8 +182,12 @@ class Driver:
         return self._call(self.reset_cli, Trigger.Request())
 
     def set_parameters(self, **values):
+        return self.set_parameters_raw([Parameter(k, value=v) for k, v in values.items()])
+
+    def set_parameters_raw(self, parameters):
+        """Send rclpy ``Parameter`` objects as they are (e.g. of type NOT_SET: ``ros2 param delete``)."""
         req = SetParameters.Request()
-        req.parameters = [Parameter(k, value=v).to_parameter_msg() for k, v in values.items()]
+        req.parameters = [p.to_parameter_msg() for p in parameters]
         return self._call(self.param_cli, req).results
 
     # ---------------------------------------------------------------- queries

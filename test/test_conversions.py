@@ -63,10 +63,10 @@ def test_bad_images_raise_clear_errors(bgr):
         image_to_array("bgr8", 5, 7, 20, data)
     with pytest.raises(ValueError, match="has 105 bytes, expected step\\*height = 24\\*5 = 120"):
         image_to_array("bgr8", 5, 7, 24, data)
-    with pytest.raises(ValueError, match="empty"):
+    with pytest.raises(ValueError, match=r"image height = 0 px is out of \[2, 16384\] px"):
         image_to_array("mono8", 0, 7, 7, b"")
     with pytest.raises(ValueError, match="bytes-like"):
-        image_to_array("mono8", 1, 2, 2, object())
+        image_to_array("mono8", 2, 2, 2, object())
 
 
 def test_array_to_image_fields_round_trip(bgr):

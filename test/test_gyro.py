@@ -159,13 +159,14 @@ def test_gyro_config_checks_itself():
            ({"R_cam_imu": [1.0, 0.0, 0.0]}, "gyro.R_cam_imu must have 9 values"),
            ({"bias": [0.0, np.nan, 0.0]}, r"gyro.bias\[1\] must be finite"),
            ({"buffer_samples": 1}, r"gyro.buffer_samples must be in \[2, "), ({"buffer_ns": 0}, "gyro.buffer_ns"),
-           ({"saturation": -1.0}, "gyro.saturation"), ({"max_gap_ns": 0}, "gyro.max_gap_ns"),
+           ({"saturation": -1.0}, "gyro.saturation"), ({"saturation": 0.0}, r"gyro.saturation must be in \[1, 1000\]"),
+           ({"max_gap_ns": 0}, "gyro.max_gap_ns"),
            ({"still_bias_samples": 1}, "still-bias sample count"), ({"still_bias_max_std": 0.0}, "still_bias_max_std"),
            ({"time_offset_ns": 0.5}, "gyro.time_offset_ns must be an integer")]
     for kw, msg in bad:
         with pytest.raises(ValueError, match=msg):
             GyroConfig(**kw)
-    assert GyroConfig(saturation=0.0).saturation_limit is None and GyroConfig(saturation=35.0).saturation_limit == 35.0
+    assert GyroPredictor(None, GyroConfig(saturation=20.0)).buffer.saturation == 20.0
     assert GyroConfig(R_cam_imu=np.eye(3)).R_cam_imu == GyroConfig().R_cam_imu
 
 

@@ -301,3 +301,12 @@ def test_empty_and_all_rejected_batches_leave_the_stream_untouched():
     assert buf.t_newest_ns is None and not buf.covers(0)
     assert buf.stats() == dict(added=2, accepted=0, nan=1, saturated=1, duplicates=0, out_of_order=0, late=0,
                                dropped=0, stored=0)
+
+
+def test_samples_sharing_a_stamp_merge_without_overflowing():
+    """Found by test_fuzz: two finite rates near the float maximum at one stamp were averaged through their sum,
+    which overflowed to inf inside the buffer."""
+    buf = ImuBuffer()
+    buf.add(np.array([0, 0, 10]), np.array([[0.0, 0.0, 8e307], [0.0, 0.0, 1e308], [0.0, 0.0, 0.0]]))
+    t, w = buf.samples()
+    assert list(t) == [0, 10] and np.all(np.isfinite(w)) and w[0, 2] == pytest.approx(9e307)

@@ -2,6 +2,7 @@
 selection, ROS 1 vs converted ROS 2 vs direct ROS 2 bags, compressed images (PNG = raw, JPEG close to
 raw, a corrupt frame counted), bad input (exit 2, one line), no IMU."""
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -271,7 +272,7 @@ def test_bad_input(seq, bags, tmp_path, capsys):
     make_bag(seq, tmp_path / "m")
     make_bag(seq, tmp_path / "s", "sqlite3")
     make_bag(seq, tmp_path / "r.bag", "ros1")
-    _truncate(next((tmp_path / "m").glob("*.mcap")))
+    _truncate(next((tmp_path / "m").glob("*.mcap")), 0.2)      # inside its first chunk: nothing intact
     _truncate(next((tmp_path / "s").glob("*.db3")))
     _truncate(tmp_path / "r.bag")
     with BagWriter(tmp_path / "imu_only", "mcap") as bag:
@@ -380,3 +381,55 @@ def test_ros_args_are_split_off():
     assert split_ros_args(["a.bag", "--init", "1,2,3,4", "--ros-args", "-r", "x:=y"]) == (
         ["a.bag", "--init", "1,2,3,4"], ["--ros-args", "-r", "x:=y"])
     assert split_ros_args(["a.bag"]) == (["a.bag"], [])
+
+
+def _mcap_chunks(path: Path) -> list[int]:
+    """Byte offsets where the mcap file's chunk records end."""
+    import struct
+
+    data, pos, ends = path.read_bytes(), 8, []
+    while pos + 9 <= len(data):
+        op, size = data[pos], struct.unpack_from("<Q", data, pos + 1)[0]
+        pos += 9 + size
+        if op == 0x06:
+            ends.append(pos)
+    return ends
+
+
+def test_a_truncated_mcap_replays_its_intact_chunks_with_a_warning(seq, tmp_path, capsys):
+    """A truncated mcap (a recorder that was killed) replayed nothing, not even its intact first part."""
+    n = 24
+    long_seq = shaky_sequence(n)
+    make_bag(long_seq, tmp_path / "m")
+    mcap = next((tmp_path / "m").glob("*.mcap"))
+    full = replay(tmp_path / "m", _init(long_seq), warn=lambda s: None)
+    chunks = _mcap_chunks(mcap)
+    assert len(chunks) >= 3, chunks                  # 1 MiB chunks of 320x240 frames
+    cut = chunks[1] + 1000                           # into the third chunk
+    _truncate(mcap, cut / mcap.stat().st_size)
+    assert main([str(tmp_path / "m"), "--init", _init(long_seq), "--csv", str(tmp_path / "o.csv")]) == 0
+    err = capsys.readouterr().err
+    stop = re.search(rf"is truncated: the record at byte (\d+) of {cut} is cut short; reading its \d+ messages", err)
+    assert stop and chunks[1] <= int(stop.group(1)) < cut, err         # after the second chunk and its indexes
+    rows = read_csv_rows(tmp_path / "o.csv")[1:]
+    assert 2 <= len(rows) < n
+    got = [int(r[0]) for r in rows]
+    assert got == [int(r.stamp_ns) for r in full.results[:len(rows)]]     # the intact part, as the whole bag
+    assert csv_boxes(tmp_path / "o.csv")[-1] == pytest.approx(full.boxes[len(rows) - 1], abs=1e-9)
+    _truncate(mcap, (chunks[0] - 500) / mcap.stat().st_size)             # nothing intact: exit 2, one line
+    assert "truncated or corrupt with no intact chunk" in cli_error(
+        main, [str(tmp_path / "m"), "--init", _init(long_seq), "--csv", str(tmp_path / "p.csv")], capsys,
+        "iemd-replay: error:")
+
+
+def test_a_bare_mcap_file_path_is_accepted(seq, bags, tmp_path, capsys):
+    """A bare .mcap path was reported as its parent folder, "not a rosbag2 folder"."""
+    (tmp_path / "alone").mkdir()
+    mcap = tmp_path / "alone" / "recording.mcap"
+    shutil.copy(next((bags / "shaky").glob("*.mcap")), mcap)
+    ref = replay(bags / "shaky", _init(seq))
+    assert main([str(mcap), "--init", _init(seq), "--csv", str(tmp_path / "o.csv")]) == 0
+    assert "warning" not in capsys.readouterr().err                       # complete: nothing to warn about
+    assert [int(r[0]) for r in read_csv_rows(tmp_path / "o.csv")[1:]] == [int(r.stamp_ns) for r in ref.results]
+    assert main([str(tmp_path / "alone"), "--init", _init(seq), "--csv", str(tmp_path / "p.csv")]) == 0
+    assert not list(tmp_path.glob("iemd-mcap-*"))

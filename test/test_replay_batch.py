@@ -118,10 +118,11 @@ def test_batch_bad_input_exits_2_one_line(folder, tmp_path, capsys):
         ([str(d), str(tmp_path / "x"), "--init", boxes[0], *out], "two bags are named 'a'"),
         ([str(tmp_path / "nothing"), "--init", boxes[0], *out], "does not exist"),
         ([str(d), "--init", "1,2,3", *out], "--init must be 4 numbers"),
-        ([str(broken), "--init", boxes[0], *out, "--jobs", "2"], "z: cannot read bag"),
+        ([str(broken), "--init", boxes[0], *out, "--jobs", "2"], "truncated or corrupt"),
     ]
     for argv, text in cases:
         assert text in cli_error(main, argv, capsys, "iemd-replay: error:"), argv
+    assert cli_error(main, cases[-1][0], capsys).startswith("iemd-replay: error: z: ")     # the failed bag named
     assert not (tmp_path / "o.csv").exists()
     (tmp_path / "taken" / "a_result").mkdir(parents=True)
     assert "exists already" in cli_error(main, [str(d), *_inits(boxes), "--out-dir", str(tmp_path / "taken"),

@@ -27,7 +27,7 @@ from pathlib import Path
 from iemd_ros.common.cli import CliParser, cli_main
 from iemd_ros.common.parallel import Workers, add_worker_arguments
 from iemd_ros.evaluation.ope import (DEFAULT_OUT, DEFAULT_TRACKERS, TRACKERS, WALL_CLOCK_FIELDS, collect_sequences,
-                                     evaluate, format_table, make_tracker, results_digest)
+                                     evaluate, format_long_term, format_table, make_tracker, results_digest)
 from iemd_ros.evaluation.published import default_published, format_published, load_published
 from iemd_ros.evaluation.split import PARTS, split_names
 from iemd_ros.pipeline import PipelineConfig
@@ -112,6 +112,10 @@ def main(argv: list[str] | None = None) -> int:
         doc = evaluate(sequences, trackers, args.out, configs=configs, workers=workers)
         print()
         print(format_table(doc["results"], trackers, doc["sequences"]))
+        long_term = format_long_term(doc)
+        if long_term:
+            print()
+            print(long_term)
         if published is not None:
             print()
             print(format_published(published, doc["results"], trackers))

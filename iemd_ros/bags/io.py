@@ -5,8 +5,9 @@
   built with the writer's typestore classes (:meth:`BagWriter.msg`), so ROS 1/2 field differences
   (``Header.seq``, ``CameraInfo.K`` vs ``k``) are handled by :func:`header` / :func:`camera_info_fields`.
 * :func:`open_bag`: AnyReader over a rosbag2 folder (sqlite3 or mcap, also given as its
-  ``metadata.yaml`` / storage file) or a ROS 1 ``.bag``; every failure becomes a :class:`BagError`
-  (a ``ValueError``) with a readable message, including truncation found while reading
+  ``metadata.yaml`` / storage file), a bare ``.mcap`` file or a ROS 1 ``.bag``; an mcap cut short (a killed
+  recorder) is read up to its last intact chunk (:func:`salvage_mcap`), with a warning; every other failure becomes
+  a :class:`BagError` (a ``ValueError``) with a readable message, including truncation found while reading
   (:func:`iter_messages`).
 * :func:`select_topics`: the image / IMU / camera-info topics, auto-detected when a bag has exactly one
   topic of a type, else named (wrong type or ambiguity -> BagError).  The image topic is a
@@ -31,7 +32,7 @@ from iemd_ros.common.cli import one_line
 __all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "FORMATS",
            "BagError", "BagMessages", "BagWriter", "Topics", "camera_info_fields", "custom_data", "deserialize",
            "header", "iter_messages", "open_bag", "resolve_bag_path", "ros1_typestore", "ros2_typestore",
-           "select_topics"]
+           "salvage_mcap", "Salvage", "select_topics"]
 
 IMAGE_TYPE = "sensor_msgs/msg/Image"
 COMPRESSED_IMAGE_TYPE = "sensor_msgs/msg/CompressedImage"
@@ -318,6 +319,17 @@ def resolve_bag_path(path) -> Path:
     return p
 
 
+def _lone_mcap(path: Path) -> Path | None:
+    """The mcap file a bag path names without a ``metadata.yaml`` beside it (a bare ``.mcap`` file, or a folder
+    holding one, as a killed recorder leaves it), else None."""
+    if path.is_file() and path.suffix == ".mcap" and not (path.parent / "metadata.yaml").is_file():
+        return path
+    if path.is_dir() and not (path / "metadata.yaml").is_file():
+        files = sorted(path.glob("*.mcap"))
+        return files[0] if len(files) == 1 else None
+    return None
+
+
 def _reader_errors() -> tuple:
     import sqlite3
     import struct
@@ -333,13 +345,19 @@ def _reader_errors() -> tuple:
             struct.error, zlib.error, EOFError, OSError, KeyError, IndexError, ValueError, AssertionError)
 
 
-def open_bag(path):
+def open_bag(path, warn=None):
     """Open a bag with rosbags' AnyReader.
+
+    An mcap file that cannot be opened as it is (a recorder killed before it wrote the summary, a file cut short)
+    and a bare ``.mcap`` file without its ``metadata.yaml`` are read record by record up to the last intact chunk
+    (:func:`salvage_mcap`); ``warn`` is told where a truncated one stopped.
 
     Parameters
     ----------
     path : str or path-like
-        As :func:`resolve_bag_path` takes it.
+        As :func:`resolve_bag_path` takes it, or a bare ``.mcap`` file.
+    warn : callable, optional
+        Receives a warning (one line) when only a part of the bag can be read.
 
     Returns
     -------
@@ -349,17 +367,179 @@ def open_bag(path):
     Raises
     ------
     BagError
-        For a bag that is missing, truncated or corrupt.
+        For a bag that is missing, truncated with nothing intact, or corrupt.
     """
     from rosbags.highlevel import AnyReader
 
+    p = Path(path)
+    lone = _lone_mcap(p) if p.exists() else None
+    if lone is not None:
+        return _salvaged_reader(lone, warn)
     p = resolve_bag_path(path)
     try:
         reader = AnyReader([p], default_typestore=ros2_typestore())
         reader.open()
     except _reader_errors() as exc:
+        storage = sorted(p.glob("*.mcap")) if p.is_dir() else []
+        if len(storage) == 1:
+            return _salvaged_reader(storage[0], warn)
         raise BagError(f"cannot read bag {p} (missing, truncated or corrupt?): {one_line(exc)}") from None
     return reader
+
+
+def _salvaged_reader(mcap: Path, warn):
+    """An AnyReader over the intact part of ``mcap``, copied into a temporary rosbag2 folder removed on close."""
+    import tempfile
+
+    from rosbags.highlevel import AnyReader
+
+    class SalvagedReader(AnyReader):
+        def close(self) -> None:
+            try:
+                super().close()
+            finally:
+                shutil.rmtree(tmp, ignore_errors=True)
+
+    tmp = Path(tempfile.mkdtemp(prefix="iemd-mcap-"))
+    try:
+        salvage = salvage_mcap(mcap, tmp / "bag")
+        if salvage.stop:
+            if not salvage.messages:
+                raise BagError(f"bag {mcap} is truncated or corrupt with no intact chunk: {salvage.stop}")
+            if warn is not None:
+                warn(f"bag {mcap} is truncated: {salvage.stop}; reading its {salvage.messages} messages before "
+                     f"byte {salvage.intact_bytes}")
+        reader = SalvagedReader([tmp / "bag"], default_typestore=ros2_typestore())
+        reader.open()
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return reader
+
+
+@dataclass(frozen=True)
+class Salvage:
+    """What :func:`salvage_mcap` could read.
+
+    Parameters
+    ----------
+    messages : int
+        Messages copied.
+    intact_bytes : int
+        Bytes of the file before the first record that could not be read (its size when all could).
+    stop : str
+        Why the reading stopped early ("" when the whole file was read).
+    skipped_topics : tuple of str
+        Topics of types the typestore does not know, not copied.
+    """
+
+    messages: int
+    intact_bytes: int
+    stop: str
+    skipped_topics: tuple[str, ...] = ()
+
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def salvage_mcap(mcap, out) -> Salvage:
+    """Copy the messages of an mcap file, record by record, into a new rosbag2 (mcap) folder ``out``.
+
+    The file is read from its start, without the summary at its end (a killed recorder never writes one): schemas,
+    channels and messages, in and out of chunks, until the end or the first record that is cut short or whose chunk
+    does not decompress; a chunk is copied only whole.
+
+    Parameters
+    ----------
+    mcap : str or path-like
+        The mcap file.
+    out : str or path-like
+        The new rosbag2 folder (must not exist).
+
+    Returns
+    -------
+    Salvage
+        How much was copied and why it stopped.
+
+    Raises
+    ------
+    BagError
+        For a file that is not an mcap file.
+    """
+    import struct
+
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.rosbag2.storage_mcap import decompress
+
+    data = Path(mcap).read_bytes()
+    if not data.startswith(_MCAP_MAGIC):
+        raise BagError(f"{mcap} is not an mcap file (no MCAP magic)")
+    typestore = ros2_typestore()
+    schemas: dict[int, str] = {}
+    channels: dict[int, object] = {}
+    skipped: set[str] = set()
+    count = 0
+
+    def records(buf: bytes, pos: int, end: int):
+        """(opcode, body, offset after it) of each whole record in buf[pos:end]; stops at a record cut short."""
+        while pos + 9 <= end:
+            op, size = buf[pos], struct.unpack_from("<Q", buf, pos + 1)[0]
+            if pos + 9 + size > end:
+                return
+            yield op, memoryview(buf)[pos + 9:pos + 9 + size], pos + 9 + size
+            pos += 9 + size
+
+    def text(body, at: int) -> tuple[str, int]:
+        n = struct.unpack_from("<I", body, at)[0]
+        return bytes(body[at + 4:at + 4 + n]).decode(), at + 4 + n
+
+    def take(op: int, body, writer) -> None:
+        nonlocal count
+        if op == 0x03:                          # Schema: id, name, encoding, data
+            schemas[struct.unpack_from("<H", body, 0)[0]] = text(body, 2)[0]
+        elif op == 0x04:                        # Channel: id, schema id, topic, message encoding, metadata
+            cid, sid = struct.unpack_from("<HH", body, 0)
+            topic, _ = text(body, 4)
+            msgtype = schemas.get(sid, "")
+            if cid in channels or topic in skipped:
+                pass                            # a repeat (the summary section repeats the channels)
+            elif msgtype in typestore.types:
+                channels[cid] = writer.add_connection(topic, msgtype, typestore=typestore)
+            else:
+                skipped.add(topic)
+        elif op == 0x05:                        # Message: channel, sequence, log time, publish time, data
+            cid, _, log_time = struct.unpack_from("<HIQ", body, 0)
+            if cid in channels:
+                writer.write(channels[cid], log_time, bytes(body[22:]))
+                count += 1
+
+    stop, complete = "", False
+    with Writer(Path(out), version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        pos = len(_MCAP_MAGIC)
+        for op, body, after in records(data, pos, len(data)):
+            if op in (0x0F, 0x02):              # DataEnd (the summary follows) or Footer: the messages are all read
+                complete = True
+                break
+            if op == 0x06:                      # Chunk: start, end, uncompressed size, crc, compression, records
+                try:
+                    _, _, size, crc = struct.unpack_from("<QQQI", body, 0)
+                    compression, at = text(body, 28)
+                    n = struct.unpack_from("<Q", body, at)[0]
+                    inner = decompress(bytes(body[at + 8:at + 8 + n]), compression, size, crc)
+                except Exception as exc:  # any damage ends the intact part
+                    stop = f"the chunk at byte {pos} does not decompress ({one_line(exc)})"
+                    break
+                for inner_op, inner_body, _ in records(inner, 0, len(inner)):
+                    take(inner_op, inner_body, writer)
+            else:
+                take(op, body, writer)
+            pos = after
+        if complete:
+            pos = len(data)
+        elif not stop:
+            stop = (f"the record at byte {pos} of {len(data)} is cut short" if pos < len(data)
+                    else "the file ends without its data-end and footer records")
+    return Salvage(count, pos, stop, tuple(sorted(skipped)))
 
 
 def iter_messages(reader, connections, path="bag") -> Iterator[tuple[object, int, bytes]]:

@@ -294,7 +294,7 @@ class Replay:
         self.warnings: list[str] = []
         self._camera = camera
         self._drop = {int(t) for t in drop_stamps}
-        self._reader = open_bag(bag)
+        self._reader = open_bag(bag, warn=self._note)
         try:
             self.topics = select_topics(self._reader, image_topic, imu_topic, camera_info_topic)
             cfg = config if config is not None else PipelineConfig()

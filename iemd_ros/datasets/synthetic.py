@@ -52,8 +52,9 @@ class SyntheticConfig:
         Frame rate, Hz.
     n_frames : int
         Number of frames.
-    motion : {"shake", "pan", "still"}
-        The camera's motion.
+    motion : {"shake", "pan", "still", "turn_away"}
+        The camera's motion; ``turn_away``: still, then it turns ``turn_deg`` about ``pan_axis`` in ``turn_s``
+        from ``turn_start_s`` (a raised-cosine rate), holds ``turn_hold_s`` and turns back the same way.
     max_rate_deg_s : float
         Peak |w| (shake) or the constant rate (pan).
     shake_freqs_hz : tuple of float
@@ -61,7 +62,9 @@ class SyntheticConfig:
     shake_axis_weights : tuple of float
         Weights of x (tilt), y (pan), z (roll).
     pan_axis : tuple of float
-        Axis of the pan, camera frame.
+        Axis of the pan (and of the turn away), camera frame.
+    turn_deg, turn_start_s, turn_s, turn_hold_s : float
+        The turn away: its angle, start, duration of each turn, and the hold between them.
     target_size_px : float
         Side of the square target near the image centre.
     target_speed_deg_s : float
@@ -99,6 +102,10 @@ class SyntheticConfig:
     shake_freqs_hz: tuple = (1.1, 1.9, 3.1)        # per-axis sinusoid frequencies (randomised +-20 %)
     shake_axis_weights: tuple = (1.0, 1.0, 0.4)    # x (tilt), y (pan), z (roll)
     pan_axis: tuple = (0.0, 1.0, 0.0)
+    turn_deg: float = 60.0
+    turn_start_s: float = 1.0
+    turn_s: float = 0.5
+    turn_hold_s: float = 1.0
     target_size_px: float = 48.0                   # side of the square target near the image centre
     target_speed_deg_s: float = 0.0                # peak speed of the target on the scene sphere
     target_offset_deg: tuple = (0.0, 0.0)          # initial target direction (azimuth, elevation)
@@ -124,8 +131,10 @@ class SyntheticConfig:
         if self.width < 16 or self.height < 16 or self.n_frames < 2 or self.fps <= 0:
             raise ValueError(f"need width, height >= 16, n_frames >= 2 and fps > 0, got "
                              f"{self.width}x{self.height}, {self.n_frames} frames at {self.fps} fps")
-        if self.motion not in ("shake", "pan", "still"):
-            raise ValueError(f"motion must be 'shake', 'pan' or 'still', got {self.motion!r}")
+        if self.motion not in ("shake", "pan", "still", "turn_away"):
+            raise ValueError(f"motion must be 'shake', 'pan', 'still' or 'turn_away', got {self.motion!r}")
+        if self.motion == "turn_away" and not (self.turn_s > 0 and self.turn_hold_s >= 0 and self.turn_start_s >= 0):
+            raise ValueError("turn_away needs turn_s > 0, turn_hold_s >= 0 and turn_start_s >= 0")
         if not 10 <= self.hfov_deg <= 120:
             raise ValueError(f"hfov_deg must be in [10, 120], got {self.hfov_deg}")
         if self.gyro_rate_hz <= 0 or self.gyro_noise_std < 0 or self.gyro_jitter_s < 0 or self.still_start_s < 0:
@@ -211,6 +220,8 @@ def _rate_function(cfg: SyntheticConfig):
     rng = np.random.default_rng([cfg.seed, 1])
     if cfg.motion == "still":
         base = lambda t: np.zeros(t.shape + (3,))  # noqa: E731
+    elif cfg.motion == "turn_away":
+        base = _turn_away_rate(cfg)
     elif cfg.motion == "pan":
         axis = np.asarray(cfg.pan_axis, float)
         w0 = axis / np.linalg.norm(axis) * np.radians(cfg.max_rate_deg_s)
@@ -235,6 +246,21 @@ def _rate_function(cfg: SyntheticConfig):
         s = np.clip((t + 0.2) / 0.2, 0.0, 1.0)
         return base(t) * (s * s * (3 - 2 * s))[..., None]
     return ramped
+
+
+def _turn_away_rate(cfg: SyntheticConfig):
+    """The turn away and back: a raised-cosine rate bump about ``pan_axis`` whose integral is ``turn_deg``, then the
+    hold, then the same bump reversed."""
+    axis = np.asarray(cfg.pan_axis, float)
+    axis = axis / np.linalg.norm(axis)
+    peak = 2 * np.radians(cfg.turn_deg) / cfg.turn_s  # (1 - cos) averages 1: the bump's integral is turn_deg
+    back = cfg.turn_start_s + cfg.turn_s + cfg.turn_hold_s
+
+    def bump(t, start):
+        u = (t - start) / cfg.turn_s
+        return np.where((u >= 0) & (u <= 1), 0.5 * peak * (1 - np.cos(2 * np.pi * u)), 0.0)
+
+    return lambda t: (bump(t, cfg.turn_start_s) - bump(t, back))[..., None] * axis
 
 
 def angular_velocity(cfg: SyntheticConfig, t_s) -> np.ndarray:

@@ -342,3 +342,90 @@ def score_sequence(pred_boxes, gt_boxes, name: str = "", fps: float | None = Non
         fps=fps,
         success_curve=[float(c) for c in curve],
     )
+
+
+#: A return counts as re-acquired once a reported box overlaps the target by at least this IoU.
+REACQUIRED_IOU = 0.3
+#: ... within this many frames of the target's return (the issue's "back on the target within 30 frames").
+REACQUIRE_WITHIN = 30
+
+
+@dataclass
+class LongTermScores:
+    """Figures of a run on a sequence where the target leaves the view (VOT's long-term measures).
+
+    Attributes
+    ----------
+    precision : float
+        Mean IoU over the frames where the tracker reports the target (a report on an absent target scores 0).
+    recall : float
+        Mean IoU over the frames where the target is present (a frame without report scores 0).
+    f_score : float
+        2 precision recall / (precision + recall).
+    absent_frames : int
+        Frames whose GT box is invalid (the target out of view).
+    false_report_rate : float
+        Share of the absent frames on which the tracker reported a box.
+    returns : int
+        Times the target came back into view (absent -> present).
+    reacquired : int
+        Returns after which a reported box reached :data:`REACQUIRED_IOU` within :data:`REACQUIRE_WITHIN` frames.
+    delays : list of int
+        Per return, frames from the return to the first such report (-1: never).
+    """
+
+    precision: float
+    recall: float
+    f_score: float
+    absent_frames: int
+    false_report_rate: float
+    returns: int
+    reacquired: int
+    delays: list[int] = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def long_term_scores(pred_boxes, reported, gt_boxes) -> LongTermScores:
+    """VOT long-term precision, recall and F-score of a run, with the false reports and the re-acquisitions.
+
+    Parameters
+    ----------
+    pred_boxes : array_like
+        (N, 4) the tracker's boxes (ignored where ``reported`` is False).
+    reported : array_like of bool
+        (N,) whether the tracker reported the target on each frame.
+    gt_boxes : array_like
+        (N, 4) GT boxes, invalid (NaN) where the target is absent.
+
+    Returns
+    -------
+    LongTermScores
+
+    Raises
+    ------
+    ValueError
+        For arrays of different lengths, or no present and no reported frame.
+    """
+    pred = _as_boxes(pred_boxes, "pred_boxes")
+    gt = _as_boxes(gt_boxes, "gt_boxes")
+    rep = np.asarray(reported, dtype=bool).ravel()
+    if not len(pred) == len(gt) == len(rep):
+        raise ValueError(f"{len(pred)} boxes, {len(rep)} report flags and {len(gt)} GT boxes: lengths differ")
+    rep = rep & valid_boxes(pred)
+    present = valid_boxes(gt)
+    ov = np.where(rep & present, iou(pred, gt), 0.0)
+    if not present.any() and not rep.any():
+        raise ValueError("no frame where the target is present or reported: nothing to score")
+    precision = float(ov[rep].mean()) if rep.any() else 0.0
+    recall = float(ov[present].mean()) if present.any() else 0.0
+    f = 2 * precision * recall / (precision + recall) if precision + recall > 0 else 0.0
+    absent = ~present
+    delays = []
+    for start in np.flatnonzero(present[1:] & absent[:-1]) + 1:
+        window = np.flatnonzero(ov[start:start + REACQUIRE_WITHIN] >= REACQUIRED_IOU)
+        delays.append(int(window[0]) if window.size else -1)
+    return LongTermScores(precision=precision, recall=recall, f_score=f, absent_frames=int(absent.sum()),
+                          false_report_rate=float(rep[absent].mean()) if absent.any() else 0.0,
+                          returns=len(delays), reacquired=sum(d >= 0 for d in delays), delays=delays)

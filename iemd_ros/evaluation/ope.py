@@ -33,7 +33,8 @@ import cv2
 import numpy as np
 
 from iemd_ros.common.parallel import Workers, run_jobs
-from iemd_ros.evaluation.metrics import OTB_THRESHOLDS, PRECISION_THRESHOLD, SequenceScores, score_sequence, valid_boxes
+from iemd_ros.evaluation.metrics import (OTB_THRESHOLDS, PRECISION_THRESHOLD, SequenceScores, long_term_scores,
+                                         score_sequence, valid_boxes)
 from iemd_ros.datasets.otb import Sequence, default_roots, is_sequence_folder, list_sequences, load_sequence
 from iemd_ros.tracking import IemdTracker, TrackerConfig
 
@@ -352,6 +353,8 @@ def run_job(job: EvalJob) -> tuple[SequenceScores, dict]:
         boxes=run.boxes.tolist(),
         ok=run.ok.tolist(),
     )
+    if not valid_boxes(job.sequence.gt_boxes).all():  # the target leaves the view: VOT's long-term measures too
+        entry["long_term"] = long_term_scores(run.boxes, run.ok, job.sequence.gt_boxes).to_dict()
     return scores, entry
 
 
@@ -374,6 +377,49 @@ def mean_scores(scores: list[SequenceScores]) -> dict:
     out["n_sequences"] = len(scores)
     out["n_frames"] = int(sum(s.n_frames for s in scores))
     return out
+
+
+def mean_long_term(entries: list[dict]) -> dict | None:
+    """Mean long-term figures over sequences (re-acquisitions summed); None without any.
+
+    Parameters
+    ----------
+    entries : list of dict
+        :class:`~iemd_ros.evaluation.metrics.LongTermScores` as dicts.
+
+    Returns
+    -------
+    dict or None
+    """
+    if not entries:
+        return None
+    keys = ("precision", "recall", "f_score", "false_report_rate")
+    out = {k: float(np.mean([e[k] for e in entries])) for k in keys}
+    out.update(returns=sum(e["returns"] for e in entries), reacquired=sum(e["reacquired"] for e in entries),
+               n_sequences=len(entries))
+    return out
+
+
+def format_long_term(doc: dict) -> str:
+    """The long-term measures of the sequences where the target leaves the view, and their means ("" if none)."""
+    trackers = doc["trackers"]
+    names = [n for n in doc["sequences"] if "long_term" in doc["results"][trackers[0]][n]]
+    if not names:
+        return ""
+    header = f"{'sequence':<14} {'tracker':<7} {'P%':>6} {'R%':>6} {'F%':>6} {'reports on absent%':>19} {'back':>6}"
+    lines = ["long-term measures (the target leaves the view):", header, "-" * len(header)]
+
+    def row(label: str, trk: str, s: dict) -> str:
+        return (f"{label:<14} {trk:<7} {_pct(s['precision'])} {_pct(s['recall'])} {_pct(s['f_score'])} "
+                f"{100 * s['false_report_rate']:19.1f} {s['reacquired']:>3d}/{s['returns']:<2d}")
+
+    for name in names:
+        for trk in trackers:
+            lines.append(row(name, trk, doc["results"][trk][name]["long_term"]))
+    lines.append("-" * len(header))
+    for trk in trackers:
+        lines.append(row(f"MEAN ({len(names)})", trk, doc["long_term"][trk]))
+    return "\n".join(lines)
 
 
 def plot_success(curves: dict[str, list[float]], title: str, path: Path) -> None:
@@ -608,7 +654,10 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
         **({"iemd_config": configs.get("iemd", TrackerConfig()).to_dict()} if "iemd" in trackers else {}),
         "sequences": [s.name for s in sequences],
         "groups": {s.name: s.group for s in sequences},
-        "ground_truth": {s.name: s.gt_boxes.tolist() for s in sequences},
+        "ground_truth": {s.name: [[None if np.isnan(v) else v for v in box] for box in s.gt_boxes.tolist()]
+                         for s in sequences},
+        "long_term": {trk: mean_long_term([results[trk][s.name]["long_term"] for s in sequences
+                                           if "long_term" in results[trk][s.name]]) for trk in trackers},
         "frame_numbers": {s.name: list(s.frame_numbers) for s in sequences},
         "results": results,
     }

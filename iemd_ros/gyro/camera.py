@@ -17,6 +17,8 @@ import cv2
 import numba
 import numpy as np
 
+from iemd_ros.common.limits import FOCAL_LENGTH, PRINCIPAL_POINT
+
 __all__ = ["CameraModel"]
 
 
@@ -39,14 +41,16 @@ class CameraModel:
         The plumb_bob coefficients [k1, k2, p1, p2, k3]: at most 5 finite values, the missing ones 0 (None: no
         distortion).
     width, height : int, optional
-        Image size in pixels, both or neither.
+        Image size in pixels, both or neither: K is then checked against it (:meth:`check_image`).
     name : str, optional
         The camera's name (camera_info's ``camera_name``).
 
     Raises
     ------
     ValueError
-        For a ``K`` or ``D`` that is not so, or an image size that is not two positive integers.
+        For a ``K`` or ``D`` that is not so, an image size that is not two positive integers, or a focal length or
+        principal point out of its limit for that size (:data:`~iemd_ros.common.limits.FOCAL_LENGTH`,
+        :data:`~iemd_ros.common.limits.PRINCIPAL_POINT`).
     """
 
     def __init__(self, K, D=None, width: int | None = None, height: int | None = None, name: str = ""):
@@ -70,6 +74,37 @@ class CameraModel:
         self.width = None if width is None else int(width)
         self.height = None if height is None else int(height)
         self.name = name
+        if self.width is not None:
+            self._check_intrinsics(self.width, self.height)
+
+    def check_image(self, width: int, height: int) -> None:
+        """Check that the camera describes images of ``width`` x ``height`` px.
+
+        Its own image size, when it has one, must be that; without one, K is checked against that size.
+
+        Parameters
+        ----------
+        width, height : int
+            The image's size, px.
+
+        Raises
+        ------
+        ValueError
+            Saying what does not fit.
+        """
+        if self.width is None:
+            self._check_intrinsics(int(width), int(height))
+        elif (self.width, self.height) != (int(width), int(height)):
+            raise ValueError(f"camera_info is for {self.width}x{self.height} images, this image is {width}x{height}")
+
+    def _check_intrinsics(self, width: int, height: int) -> None:
+        """ValueError naming the entry of K out of its limit for ``width`` x ``height`` images."""
+        K = self.K
+        side = max(width, height)
+        FOCAL_LENGTH.check("camera_info k[0] (fx)", K[0, 0], side)
+        FOCAL_LENGTH.check("camera_info k[4] (fy)", K[1, 1], side)
+        PRINCIPAL_POINT.check("camera_info k[2] (cx)", K[0, 2], width)
+        PRINCIPAL_POINT.check("camera_info k[5] (cy)", K[1, 2], height)
 
     # ------------------------------------------------------------------ construction
     @classmethod

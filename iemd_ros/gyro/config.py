@@ -38,8 +38,9 @@ class GyroConfig:
                                     range=(0, 100_000))
     still_bias_max_std: float = param(0.02, "largest per-axis standard deviation of a still start", unit="rad/s",
                                       range=(1e-6, 1.0))
-    saturation: float = param(0.0, "reject samples with |w_i| >= this (0: no limit)", unit="rad/s",
-                              range=(0.0, 1000.0))
+    saturation: float = param(35.0, "reject samples with |w_i| >= this: a MEMS gyro's full scale (2000 deg/s = "
+                              "34.9 rad/s is the largest common one)", unit="rad/s", range=(1.0, 1000.0),
+                              decision="gyro-saturation")
     max_gap_ns: int = param(50_000_000, "IMU sample spacing reported as a gap", unit="ns", range=(1e6, 1e10))
     buffer_ns: int = param(10_000_000_000, "IMU history kept", unit="ns", range=(1e8, 1e14))
     buffer_samples: int = param(20_000, "IMU samples kept at most", range=(2, 1e8))
@@ -51,14 +52,12 @@ class GyroConfig:
             self.R_cam_imu = IDENTITY
         if self.bias is None:
             self.bias = (0.0, 0.0, 0.0)
-        if self.saturation is None:
-            self.saturation = 0.0
         if isinstance(self.R_cam_imu, np.ndarray):
             self.R_cam_imu = self.R_cam_imu.ravel()
         coerce(self, "gyro.")
         try:
             GyroCalibration.checked(self.rotation, self.bias)
-            ImuBuffer.check_settings(self.buffer_ns, self.buffer_samples, self.saturation_limit, self.max_gap_ns)
+            ImuBuffer.check_settings(self.buffer_ns, self.buffer_samples, self.saturation, self.max_gap_ns)
             StillBiasEstimator.check_settings(self.still_bias_samples, self.still_bias_max_std)
         except ValueError as exc:
             raise ValueError(f"gyro: {exc}") from None
@@ -67,11 +66,6 @@ class GyroConfig:
     def rotation(self) -> np.ndarray:
         """R_cam_imu as a 3x3 array."""
         return np.asarray(self.R_cam_imu, dtype=float).reshape(3, 3)
-
-    @property
-    def saturation_limit(self) -> float | None:
-        """The saturation limit, None for none."""
-        return self.saturation if self.saturation > 0 else None
 
     @classmethod
     def from_dict(cls, values: dict) -> "GyroConfig":

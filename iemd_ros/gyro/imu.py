@@ -247,7 +247,9 @@ class ImuBuffer:
         if len(start) < len(tt):
             self.counts["duplicates"] += len(tt) - len(start)
             nn = np.add.reduceat(n[lo:], start)
-            wt = np.add.reduceat(w[lo:] * n[lo:, None], start, axis=0) / nn[:, None]
+            group = np.repeat(np.arange(len(start)), np.diff(np.append(start, len(tt))))
+            # the weights of each stamp's mean sum to 1, so no finite rates add up to infinity
+            wt = np.add.reduceat(w[lo:] * (n[lo:] / nn[group])[:, None], start, axis=0)
             t, w, n = np.concatenate([t[:lo], tt[start]]), np.concatenate([w[:lo], wt]), np.concatenate([n[:lo], nn])
         keep_from = max(len(t) - self.max_samples, int(np.searchsorted(t, t[-1] - self.max_duration_ns)))
         self.counts["dropped"] += keep_from

@@ -329,7 +329,7 @@ class GyroPredictor:
         self.camera = camera
         self.config = cfg = config if config is not None else GyroConfig()
         self._cal = GyroCalibration(cfg.rotation, cfg.bias)
-        self.buffer = ImuBuffer(cfg.buffer_ns, cfg.buffer_samples, cfg.saturation_limit, cfg.max_gap_ns)
+        self.buffer = ImuBuffer(cfg.buffer_ns, cfg.buffer_samples, cfg.saturation, cfg.max_gap_ns)
         self.bias_estimator = StillBiasEstimator(cfg.still_bias_samples, cfg.still_bias_max_std)
 
     @property

@@ -21,8 +21,9 @@ from typing import NamedTuple
 import cv2
 import numpy as np
 
-from iemd_ros.gyro.camera import CameraModel
 from iemd_ros.common.boxes import box_centre, centre_box, check_box
+from iemd_ros.common.limits import IMAGE_SIDE
+from iemd_ros.gyro.camera import CameraModel
 
 __all__ = ["ENCODINGS", "COMPRESSED_CODECS", "JPEG_QUALITY", "image_to_array", "compressed_to_array",
            "array_to_image_fields", "array_to_compressed_fields", "check_compression", "compressed_topic",
@@ -79,14 +80,13 @@ def image_to_array(encoding: str, height: int, width: int, step: int, data, is_b
     Raises
     ------
     ValueError
-        For an unknown encoding, an empty image, a ``step`` shorter than a row or a ``data`` size other than
-        ``step * height``.
+        For an unknown encoding, a width or height out of :data:`~iemd_ros.common.limits.IMAGE_SIDE`, a ``step``
+        shorter than a row or a ``data`` size other than ``step * height``.
     """
     if encoding not in ENCODINGS:
         raise ValueError(f"unsupported image encoding {encoding!r}: expected one of {', '.join(ENCODINGS)}")
     height, width, step = int(height), int(width), int(step)
-    if height <= 0 or width <= 0:
-        raise ValueError(f"image is empty: {width}x{height}")
+    _check_size(width, height)
     channels, depth = ENCODINGS[encoding]
     row = width * channels * depth
     if step < row:
@@ -105,6 +105,12 @@ def image_to_array(encoding: str, height: int, width: int, step: int, data, is_b
     if encoding == "bgra8":
         return np.ascontiguousarray(pix[..., :3])
     return np.ascontiguousarray(pix[..., 2::-1])      # rgba8
+
+
+def _check_size(width: int, height: int) -> None:
+    """ValueError unless the image's width and height are within :data:`~iemd_ros.common.limits.IMAGE_SIDE`."""
+    IMAGE_SIDE.check("image width", width)
+    IMAGE_SIDE.check("image height", height)
 
 
 def _to_8bit(pixels: np.ndarray) -> np.ndarray:
@@ -136,7 +142,8 @@ def compressed_to_array(fmt: str, data) -> np.ndarray:
     Raises
     ------
     ValueError
-        For data that do not decode, and for ``compressedDepth`` (depth maps, not camera images).
+        For data that do not decode, an image size out of :data:`~iemd_ros.common.limits.IMAGE_SIDE`, and for
+        ``compressedDepth`` (depth maps, not camera images).
     """
     if "compresseddepth" in str(fmt).lower():
         raise ValueError(f"compressed image format {fmt!r} is a depth map (compressedDepth), not a camera image")
@@ -154,6 +161,7 @@ def compressed_to_array(fmt: str, data) -> np.ndarray:
         img = _to_8bit(img)
     elif img.dtype != np.uint8:
         raise ValueError(f"compressed image ({fmt!r}) decodes to {img.dtype} pixels; expected 8 or 16 bits")
+    _check_size(img.shape[1], img.shape[0])
     if img.ndim == 3 and img.shape[2] == 4:
         img = img[..., :3]
     return np.ascontiguousarray(img)
@@ -391,8 +399,9 @@ def camera_model_from_info(k, d, distortion_model: str, width: int, height: int)
     Raises
     ------
     ValueError
-        For a ``k`` not of 9 values, an all-zero ``k`` (an uncalibrated driver) and non-plumb_bob models with non-zero
-        coefficients, saying so.
+        For a ``k`` not of 9 values, an all-zero ``k`` (an uncalibrated driver), non-plumb_bob models with non-zero
+        coefficients, and a focal length or principal point out of its limit for the image size (:class:`CameraModel`),
+        saying so.
     """
     K = np.asarray(k, dtype=float).ravel()
     if K.shape != (9,):

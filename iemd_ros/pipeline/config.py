@@ -34,6 +34,9 @@ class PipelineConfig:
     clock_reset_ms: float = param(1000.0, "a stamp this much earlier than the previous one is a clock reset (smaller "
                                   "steps back reject the frame)", unit="ms", range=(1.0, 1e7))
     score_emd_scale: float = param(0.25, "detection score = exp(-EMD / score_emd_scale)", range=(1e-6, 100.0))
+    watchdog_ms: float = param(2000.0, "a tracker update still running after this long is abandoned: the frame is "
+                               "answered without a detection and the tracker rebuilt at its last good window",
+                               unit="ms", range=(100.0, 600_000.0), decision="watchdog")
 
     def __post_init__(self):
         for name, kind in GROUPS.items():

@@ -86,18 +86,21 @@ def statuses(d: dict) -> list[Status]:
     return [
         Status(Part.TRACKING, *_tracking(d), vals(
             "state", "held", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
-            "processing_ms_max", "processing_rate_hz", "inits", "resets", "frame_reason")),
+            "processing_ms_max", "processing_rate_hz", "inits", "resets", "updates_abandoned", "frame_reason")),
         Status(Part.IMAGE, *_image(d), vals(
             "frames_received", "frames_processed", "frames_dropped", "frames_rejected", "images_malformed",
             "input_rate_hz", "processing_rate_hz", "recent_dropped", "image_error", "drop_reason", "clock_resets")),
         Status(Part.IMU, *_imu(d), vals(
             "imu_received", "imu_rejected", "imu_out_of_order", "imu_saturated", "imu_stored", "imu_pending",
             "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status")),
-        Status(Part.CAMERA, *_camera(d), vals("camera", "camera_infos", "camera_infos_rejected", "camera_error")),
+        Status(Part.CAMERA, *_camera(d), vals("camera", "camera_infos", "camera_infos_rejected", "camera_error",
+                                              "camera_misfit")),
     ]
 
 
 def _tracking(d: dict) -> tuple[Level, str]:
+    if d["watchdog_reason"]:
+        return Level.ERROR, f"latest frame: {d['watchdog_reason']} ({d['updates_abandoned']} abandoned so far)"
     if d["state"] == "uninitialized":
         return Level.WARN, "no target: set the initial_box parameter or publish on ~/init"
     if d["state"] == "lost":
@@ -142,6 +145,8 @@ def _camera(d: dict) -> tuple[Level, str]:
         return Level.OK, "no camera_info (not needed: gyro disabled)"
     if d["camera_error"]:
         return Level.WARN, f"latest camera_info rejected ({d['camera_error']}); keeping the previous one"
+    if d["camera_misfit"]:
+        return Level.WARN, f"camera model does not fit the images, no gyro prior: {d['camera_misfit']}"
     return Level.OK, "camera model received"
 
 

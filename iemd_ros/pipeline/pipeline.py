@@ -38,6 +38,7 @@ from iemd_ros.gyro.predictor import warm_up as warm_up_gyro
 from iemd_ros.pipeline.config import PipelineConfig
 from iemd_ros.pipeline.diagnostics import Status, rate_hz, statuses
 from iemd_ros.pipeline.results import INIT_REASON, FrameResult, Rejection, TrackState
+from iemd_ros.pipeline.watchdog import Abandoned, Watchdog
 from iemd_ros.tracking import IemdTracker
 from iemd_ros.tracking.tracker import warm_up as warm_up_tracker
 
@@ -93,9 +94,11 @@ class TrackingPipeline:
         self.counters = dict(frames_received=0, frames_processed=0, frames_uninitialized=0, frames_dropped=0,
                              frames_rejected=0, images_malformed=0, frames_lost=0, frames_held=0, gyro_used=0, gyro_unused=0,
                              imu_received=0, imu_rejected=0, imu_out_of_order=0, imu_saturated=0,
-                             clock_resets=0, camera_infos=0, camera_infos_rejected=0, inits=0, resets=0)
+                             clock_resets=0, camera_infos=0, camera_infos_rejected=0, inits=0, resets=0,
+                             updates_abandoned=0)
         self._last = dict(frame_reason="", gyro_reason="", imu_reason="", image_error="", camera_error="",
-                          drop_reason="")
+                          drop_reason="", camera_misfit="", watchdog_reason="")
+        self._watchdog = Watchdog()
         self._last_result: FrameResult | None = None
         self._image_bad = False          # the latest image message was malformed
         self._stamp_rejected = False     # the latest frame was rejected for its stamp
@@ -412,7 +415,7 @@ class TrackingPipeline:
                 self._ref = (int(stamp_ns), box, frame)
                 self._state, self._lost_run = TrackState.TRACKING, 0
                 self.counters["inits"] += 1
-                self._last["frame_reason"] = ""
+                self._last["frame_reason"] = self._last["watchdog_reason"] = ""
                 if self._last_stamp is None or int(stamp_ns) > self._last_stamp:
                     self._last_stamp = int(stamp_ns)
         return FrameResult(stamp_ns=int(stamp_ns), state=TrackState.TRACKING, box=box, score=1.0, reason=INIT_REASON,
@@ -424,6 +427,7 @@ class TrackingPipeline:
             self._tracker, self._ref = None, None
             self._state, self._lost_run = TrackState.UNINITIALIZED, 0
             self._last_result = None
+            self._last["watchdog_reason"] = ""
             self.counters["resets"] += 1
 
     def process(self, frame: np.ndarray, stamp_ns: int) -> FrameResult:
@@ -464,19 +468,47 @@ class TrackingPipeline:
                     self._recent.append((t, "uninitialized"))
                     return FrameResult(stamp_ns=t, state=TrackState.UNINITIALIZED,
                                        reason="no target: waiting for an initial box")
-                prior, gyro_box, gyro_reason = self._gyro_prior(t)
+                prior, gyro_box, gyro_reason = self._gyro_prior(t, frame)
             start = time.perf_counter()
             try:
-                result = self._tracker.update(frame, prior=prior)
-            except ValueError as exc:
-                if prior is None:
-                    raise
-                gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
-                prior, gyro_box = None, None
-                result = self._tracker.update(frame)
+                try:
+                    result = self._update(frame, prior)
+                except ValueError as exc:
+                    if prior is None:
+                        raise
+                    gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
+                    prior, gyro_box = None, None
+                    result = self._update(frame, None)
+            except Abandoned as exc:
+                return self._abandon(t, exc)
             ms = (time.perf_counter() - start) * 1e3
             with self._lock:
                 return self._record(frame, t, result, prior is not None, gyro_reason, gyro_box, ms)
+
+    def _update(self, frame, prior):
+        """The tracker's update, under the watchdog (:class:`Abandoned` when it overruns ``watchdog_ms``)."""
+        tracker = self._tracker
+        return self._watchdog.run(lambda: tracker.update(frame, prior=prior), self._cfg.watchdog_ms / 1e3)
+
+    def _abandon(self, t: int, exc: Abandoned) -> FrameResult:
+        """The result of the frame at ``t`` whose update was abandoned (or not started: ``exc.ran`` False); the
+        tracker is rebuilt at its last good window (the init frame or the last frame not lost), the abandoned one is
+        left to its thread."""
+        t_ref, box, ref_frame = self._ref
+        if exc.ran:
+            tracker = IemdTracker(self._cfg.tracker)
+            tracker.init(ref_frame, box)
+            reason = (f"tracker update abandoned after {self._cfg.watchdog_ms:g} ms (watchdog_ms); the tracker is "
+                      f"rebuilt at its window of the frame stamped {t_ref} ns")
+        else:
+            tracker = self._tracker
+            reason = f"tracker update {exc} (watchdog_ms {self._cfg.watchdog_ms:g} ms): frame not tracked"
+        with self._lock:
+            self._tracker = tracker
+            self.counters["updates_abandoned"] += exc.ran
+            self._last["watchdog_reason"] = self._last["frame_reason"] = reason
+            self._recent.append((t, Rejection.ABANDONED.value))
+            return FrameResult(stamp_ns=t, state=self._state, rejection=Rejection.ABANDONED, reason=reason)
 
     def _check_stamp(self, t: int) -> str:
         """"" if a frame stamped ``t`` can be processed, else why not (handles clock resets)."""
@@ -487,6 +519,8 @@ class TrackingPipeline:
         if back > self._cfg.clock_reset_ms * 1e6:
             self.counters["clock_resets"] += 1
             self._last["frame_reason"] = f"image clock jumped back by {_ms(back)}: treated as a clock reset"
+            self._recent.clear()                       # the rates count from the reset
+            self._recent_proc.clear()
             if self._ref is not None:
                 self._ref = (t, self._ref[1], self._ref[2])     # no rotation can be integrated across it
             newest = self._predictor.buffer.t_newest_ns
@@ -497,16 +531,26 @@ class TrackingPipeline:
             return f"image stamp {t} ns repeats the previous frame's"
         return f"image stamp went back by {_ms(back)} (previous frame {last} ns)"
 
-    def _gyro_prior(self, t: int):
+    def _gyro_prior(self, t: int, frame: np.ndarray):
         """(prior or None, predicted box or None, reason) for the frame at ``t``."""
         if not self._cfg.use_gyro:
             return None, None, "gyro disabled (use_gyro is false)"
-        if self._predictor.camera is None:
+        camera = self._predictor.camera
+        if camera is None:
             return None, None, "no camera_info received: the gyro prior needs K"
+        try:
+            camera.check_image(frame.shape[1], frame.shape[0])
+            self._last["camera_misfit"] = ""
+        except ValueError as exc:
+            self._last["camera_misfit"] = str(exc)
+            return None, None, f"no gyro prior: {exc}"
         t_ref, box, _ = self._ref
         if t == t_ref:
             return None, None, "frame has the window's own stamp"
-        pred = self._predictor.predict(t_ref, t, box=box)
+        try:
+            pred = self._predictor.predict(t_ref, t, box=box)
+        except ValueError as exc:      # e.g. a rotation that cannot be integrated: the frame goes on without it
+            return None, None, f"no gyro prior: {exc}"
         if pred.prior is None:
             return None, None, pred.reason
         gyro_box = tuple(float(v) for v in pred.box) if pred.box is not None else None
@@ -530,6 +574,7 @@ class TrackingPipeline:
         score = math.exp(-emd / self._cfg.score_emd_scale) if not result.lost and math.isfinite(emd) else 0.0
         self._last["gyro_reason"] = gyro_reason
         self._last["frame_reason"] = result.reason
+        self._last["watchdog_reason"] = ""
         self._recent.append((t, self._state.value))
         self._recent_proc.append((t, ms, gyro_used))
         predicted = None if result.predicted_box is None else tuple(float(v) for v in result.predicted_box)
@@ -549,7 +594,7 @@ class TrackingPipeline:
         Returns
         -------
         dict
-            The texts frame_reason, gyro_reason, imu_reason, image_error, camera_error, drop_reason.
+            The texts frame_reason, gyro_reason, imu_reason, image_error, camera_error, drop_reason and camera_misfit.
         """
         with self._lock:
             return dict(self._last)

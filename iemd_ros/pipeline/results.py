@@ -24,6 +24,7 @@ class Rejection(enum.Enum):
 
     STAMP = "rejected"      # its stamp repeats or goes back from the previous frame's
     MALFORMED = "malformed"  # the image message did not convert or decode
+    ABANDONED = "abandoned"  # the tracker update overran watchdog_ms: the tracker was rebuilt
 
 
 @dataclass(frozen=True, kw_only=True)

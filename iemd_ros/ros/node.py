@@ -36,8 +36,8 @@ import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.exceptions import ParameterException
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
+from rclpy.parameter import Parameter as RclpyParameter
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
 from std_srvs.srv import Trigger
@@ -53,7 +53,7 @@ from iemd_ros.pipeline import FrameResult, ImuWait, Level, Part, PipelineConfig,
 from iemd_ros.pipeline.drawing import draw_result
 from iemd_ros.ros.messages import RCLPY_MESSAGES
 from iemd_ros.ros.parameters import NODE_NAME, ImageTransport, NodeConfig, descriptor, parameters
-from iemd_ros.ros.spin import spin_until_shutdown
+from iemd_ros.ros.spin import spin_until_shutdown, stopped_by_shutdown
 
 __all__ = ["TrackerNode", "main", "NODE_NAME"]
 
@@ -63,6 +63,7 @@ class Note(enum.Enum):
 
     INIT = "init"                      # an ~/init or initial_box that could not be used
     INTERNAL_ERROR = "internal error"  # an exception in the worker (a bug): ERROR until the next good frame
+    # an INIT note is a WARN while tracking (the previous target stays) until the next init or ~/reset
 
 
 class TrackerNode(Node):
@@ -89,6 +90,7 @@ class TrackerNode(Node):
         self._latest_received = None
         self._awaiting_imu: int | None = None        # stamp of the frame the worker holds for IMU coverage
         self._stop = False
+        self._busy: tuple[float, int] | None = None  # (monotonic start, stamp) of the frame the worker is on
         self._note: tuple[Note, str] | None = None   # the latest init problem / internal error
         self._last_image_wall = self._last_imu_wall = None
         self._latency_ms: deque = deque(maxlen=30)
@@ -149,6 +151,10 @@ class TrackerNode(Node):
         return check_box(box, "initial_box ([] for none)")
 
     def _on_set_parameters(self, params) -> SetParametersResult:
+        deleted = [p.name for p in params if p.type_ == RclpyParameter.Type.NOT_SET]
+        if deleted:   # `ros2 param delete`: every later change would fail on the missing parameter
+            return SetParametersResult(successful=False, reason=f"parameters cannot be deleted: {', '.join(deleted)} "
+                                                                f"(initial_box takes [] for none)")
         changes = {p.name: p.value for p in params}
         try:
             values = self._values(changes)
@@ -244,12 +250,27 @@ class TrackerNode(Node):
             try:
                 for op in ops:
                     self._apply(op)
-                if msg is not None:
-                    self._handle_frame(msg, received)
             except Exception as exc:  # a bug must not kill the worker; say so in the log and /diagnostics
-                if self._stop or not self.context.ok():
+                if self._internal_error(exc):
                     return
-                self._set_note(Note.INTERNAL_ERROR, f"internal error: {type(exc).__name__}: {exc}")
+            if msg is None:
+                continue
+            self._busy = (time.monotonic(), stamp_ns(msg.header))
+            try:
+                self._handle_frame(msg, received)
+            except Exception as exc:
+                if self._internal_error(exc):
+                    return
+                self._publish(msg, None, received)     # the frame is answered all the same: no detection
+            finally:
+                self._busy = None
+
+    def _internal_error(self, exc: Exception) -> bool:
+        """Note an exception of the worker (a bug) in the log and /diagnostics; True when the node is stopping."""
+        if self._stop or not self.context.ok():
+            return True
+        self._set_note(Note.INTERNAL_ERROR, f"internal error: {type(exc).__name__}: {exc}")
+        return False
 
     def _apply(self, op) -> None:
         kind = op[0]
@@ -288,8 +309,8 @@ class TrackerNode(Node):
         try:
             frame = image_from_msg(msg)
         except ValueError as exc:
-            self.pipeline.note_bad_image(str(exc), stamp)
             self._warn(f"image rejected: {exc}")
+            self._publish(msg, self.pipeline.note_bad_image(str(exc), stamp), received)
             return
         with self._cond:                   # initial_box (startup, parameter change, ~/reset): this frame
             pending_box, self._pending_box = self._pending_box, None
@@ -305,6 +326,8 @@ class TrackerNode(Node):
         else:
             self._wait_for_gyro(stamp)
             result = self.pipeline.process(frame, stamp)
+        if self._note is not None and self._note[0] is Note.INTERNAL_ERROR:
+            self._note = None                          # a good frame clears it
         self._publish(msg, result, received)
         self._publish_debug(msg, frame, result)
 
@@ -344,6 +367,7 @@ class TrackerNode(Node):
         values) tuples."""
         now = time.monotonic()
         timeout = self._node_cfg.input_timeout_s
+        stuck = self._stuck(now)
         out = []
         for s in self.pipeline.statuses():
             level, message, values = s.level, s.message, dict(s.values)
@@ -364,15 +388,31 @@ class TrackerNode(Node):
                             f"no IMU message received on {topic}: tracking without gyro")
                     message = note if level == Level.OK else f"{message}; {note}"
                     level = Level.WARN
+            elif s.part is Part.TRACKING and stuck:
+                level, message = Level.ERROR, stuck
             elif s.part is Part.TRACKING and self._note is not None:
                 kind, text = self._note
                 values["note"] = text
-                if self.pipeline.state is TrackState.UNINITIALIZED:
-                    message = f"{message} ({text})"
-                elif kind is Note.INTERNAL_ERROR:
+                if kind is Note.INTERNAL_ERROR:
                     level, message = Level.ERROR, text
+                elif self.pipeline.state is TrackState.UNINITIALIZED:
+                    message = f"{message} ({text})"
+                else:                                  # an ~/init that could not be used: the old target stays
+                    level, message = max(level, Level.WARN), f"{message}; {text}"
             out.append((s.name(self.get_name()), level, message, values))
         return out
+
+    def _stuck(self, now: float) -> str:
+        """Why the worker looks stuck ("" when it does not): on one frame for longer than its IMU wait and two
+        watchdog periods (the tracker update has its own watchdog; this catches the rest of the frame's path)."""
+        busy = self._busy
+        if busy is None:
+            return ""
+        cfg = self.pipeline.config
+        since = now - busy[0]
+        if since <= (cfg.imu_wait_ms + 2 * cfg.watchdog_ms) / 1e3:
+            return ""
+        return f"the tracking worker has been on the frame stamped {busy[1]} ns for {since:.1f} s (stuck?)"
 
     def _publish_diagnostics(self) -> None:
         hdr = header(RCLPY_MESSAGES, self.get_clock().now().nanoseconds, "")
@@ -397,10 +437,15 @@ def main(args=None) -> int:
         print(f"{NODE_NAME}: invalid parameters: {one_line(exc)}", file=sys.stderr)
         rclpy.try_shutdown()
         return 2
-    except (KeyboardInterrupt, ExternalShutdownException):
+    except BaseException as exc:  # a signal during start-up
+        if not stopped_by_shutdown(exc):
+            raise
         rclpy.try_shutdown()
         return 0
-    spin_until_shutdown(node)
+    try:
+        spin_until_shutdown(node)
+    except KeyboardInterrupt:  # a second Ctrl-C before the clean-up could ignore it: stopping all the same
+        pass
     return 0
 
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 
+from iemd_ros.common.limits import IMAGE_SIDE, LIMITS
 from iemd_ros.common.params import Choice, Spec, coerce, number_text, param, specs
 from iemd_ros.messages.conversions import CLASS_ID, DETECTION_ID
 from iemd_ros.pipeline.config import PipelineConfig
@@ -39,7 +40,8 @@ class NodeConfig:
     """The node's own parameters (the pipeline's are :class:`~iemd_ros.pipeline.PipelineConfig`)."""
 
     initial_box: tuple[float, ...] = param((), "[x, y, w, h] of the target, applied to the next frame (0-based "
-                                           "top-left + size); [] for none", unit="px")
+                                           "top-left + size); [] for none", unit="px",
+                                           range=(-IMAGE_SIDE.high, IMAGE_SIDE.high))
     reliable_qos: bool = param(False, "reliable QoS for image, imu and camera_info instead of sensor-data "
                                "(best effort)", read_only=True)
     image_transport: ImageTransport = param(ImageTransport.RAW, "raw: sensor_msgs/Image on image; compressed: "
@@ -183,7 +185,7 @@ def parameter_file(preset: str = "default") -> str:
 
 
 def parameter_table() -> str:
-    """The docs' table of every parameter (``docs/parameters.md``)."""
+    """The docs' table of every parameter and of the limits of message fields (``docs/parameters.md``)."""
     lines = ["# Parameters of the tracker node",
              "",
              "Generated from the parameters' declarations by `python -m iemd_ros.ros.parameters --markdown`: do not "
@@ -198,6 +200,16 @@ def parameter_table() -> str:
         decision = f"[{p.spec.decision}](decisions.md#{p.spec.decision})" if p.spec.decision else ""
         lines.append(f"| {name} | `{_yaml_value(p.default)}` | {p.spec.unit} | {_range_text(p)} | {p.spec.doc} | "
                      f"{p.spec.eq} | {decision} |")
+    lines += ["",
+              "## Limits of message fields",
+              "",
+              "Declared in `iemd_ros/common/limits.py` and checked where a message becomes numbers: a message out of "
+              "them is rejected, and `/diagnostics` names the field and its value.  The gyro rate's limit is the "
+              "parameter `gyro.saturation`.",
+              "",
+              "| field | range | meaning |",
+              "|---|---|---|"]
+    lines += [f"| {name} | {limit.text} | {limit.doc} |" for name, limit in LIMITS.items()]
     return "\n".join(lines) + "\n"
 
 

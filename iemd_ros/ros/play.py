@@ -17,6 +17,7 @@ log time of each message, for nodes with ``use_sim_time``.
 """
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import dataclass, field
 
@@ -101,7 +102,7 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
     if qos_depth < 1:
         raise ValueError(f"--qos-depth must be >= 1, got {qos_depth}")
     remap = dict(remap or {})
-    reader = open_bag(bag)
+    reader = open_bag(bag, warn=lambda text: print(f"iemd-play: warning: {text}", file=sys.stderr))
     own_init = own_node = False
     pubs: dict = {}
     try:

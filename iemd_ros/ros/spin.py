@@ -1,16 +1,76 @@
-"""The rclpy examples' spin-and-shut-down pattern, kept light (rclpy only) for small helper processes."""
+"""The rclpy examples' spin-and-shut-down pattern, kept light (rclpy only) for small helper processes.
+
+SIGINT and SIGTERM make rclpy shut the context down from its signal handler, at any moment: between two waits
+``rclpy.spin`` ends with ExternalShutdownException, but in the middle of one it can raise RCLError ("failed to
+initialize wait set: the given context is not valid"), and so can the node's own calls.  Both are a clean stop.
+"""
 from __future__ import annotations
+
+import signal
+import threading
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+
+__all__ = ["spin_until_shutdown", "stopped_by_shutdown"]
+
+
+def stopped_by_shutdown(exc: BaseException, context=None) -> bool:
+    """Whether ``exc`` is how a shutdown (Ctrl-C, SIGTERM, ``rclpy.shutdown``) ended a call.
+
+    Parameters
+    ----------
+    exc : BaseException
+        What the call raised.
+    context : rclpy.context.Context, optional
+        The context of the call (default: rclpy's default context).
+
+    Returns
+    -------
+    bool
+        True for KeyboardInterrupt and ExternalShutdownException, and for an RCLError once the context is shut down.
+    """
+    if isinstance(exc, (KeyboardInterrupt, ExternalShutdownException)):
+        return True
+    context = context if context is not None else rclpy.get_default_context()
+    return isinstance(exc, _rclpy.RCLError) and not context.ok()
 
 
 def spin_until_shutdown(node) -> None:
-    """Spin ``node`` until Ctrl-C or an external shutdown, then destroy it and shut rclpy down."""
+    """Spin ``node`` until Ctrl-C, SIGTERM or an external shutdown, then destroy it and shut rclpy down.
+
+    Once spinning has ended, further SIGINT and SIGTERM are ignored (the process is stopping already).
+
+    Parameters
+    ----------
+    node : rclpy.node.Node
+        The node.
+
+    Raises
+    ------
+    Exception
+        What spinning raised, unless it was the shutdown (:func:`stopped_by_shutdown`).
+    """
     try:
         rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+    except BaseException as exc:
+        if not stopped_by_shutdown(exc, node.context):
+            raise
     finally:
-        node.destroy_node()
-        rclpy.try_shutdown()
+        _ignore_stop_signals()
+        try:
+            node.destroy_node()
+        except _rclpy.RCLError:
+            if node.context.ok():
+                raise
+        rclpy.try_shutdown(context=node.context)
+
+
+def _ignore_stop_signals() -> None:
+    """Ignore further SIGINT / SIGTERM while the node is taken down (a bounded wait: its worker is joined for at
+    most 5 s): a second Ctrl-C, or launch's SIGTERM after its SIGINT, would otherwise interrupt the clean-up with a
+    traceback.  Signal handlers can only be set from the main thread."""
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)

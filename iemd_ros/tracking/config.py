@@ -7,9 +7,13 @@ from dataclasses import asdict, dataclass, fields
 from iemd_ros.common.params import Choice, coerce, param
 from iemd_ros.tracking.appearance import PatchLayout
 
-__all__ = ["TrackerConfig", "Gradient", "ScaleEstimator", "PRESETS"]
+__all__ = ["TrackerConfig", "Gradient", "ScaleEstimator", "PRESETS", "MAX_PATCHES", "MAX_PATCH_PIXELS"]
 
 PRESETS = ("default", "paper")  # modules of iemd_ros.tracking.presets
+# The most patches, and patch pixels, a window may be coded with: those of a 96x96 template with 8x8 patches at
+# step 4 (docs/decisions.md#patch-budget)
+MAX_PATCHES = 529
+MAX_PATCH_PIXELS = 529 * 64
 
 
 class Gradient(Choice):
@@ -95,9 +99,16 @@ class TrackerConfig:
             raise ValueError(f"tracker.scale_range ({self.scale_range}) must be at least scale_step "
                              f"({self.scale_step})")
         try:
-            PatchLayout(self.template_size, self.patch_size, self.patch_step)
+            layout = PatchLayout(self.template_size, self.patch_size, self.patch_step)
         except ValueError as exc:
             raise ValueError(f"tracker: {exc}") from None
+        patches = layout.cells[0] * layout.cells[1]
+        pixels = patches * self.patch_size[0] * self.patch_size[1]
+        if patches > MAX_PATCHES or pixels > MAX_PATCH_PIXELS:
+            raise ValueError(f"tracker: template_size {list(self.template_size)}, patch_size {list(self.patch_size)} "
+                             f"and patch_step {self.patch_step} code a window with {patches} patches of "
+                             f"{pixels} pixels; at most {MAX_PATCHES} patches and {MAX_PATCH_PIXELS} pixels (a 96x96 "
+                             f"template of 8x8 patches at step 4) keep an update within the watchdog")
 
     @classmethod
     def preset(cls, name: str) -> "TrackerConfig":

@@ -45,18 +45,23 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     Returns
     -------
     ndarray or None
-        (dx, dy) in px; None when too few points can be followed, or for frames of different sizes.
+        (dx, dy) in px; None when too few points can be followed, when ``prior`` takes the window out of the image
+        (or to infinity), or for frames of different sizes.
     """
     if previous.shape != current.shape:
         return None
     x, y, w, h = (float(v) for v in box)
     corners = np.array([[x, y], [x + w, y], [x, y + h], [x + w, y + h]])
-    predicted = corners if prior is None else map_points(prior, corners)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        predicted = corners if prior is None else map_points(prior, corners)
+    image = np.array([previous.shape[1], previous.shape[0]], dtype=float)
+    # A prior taking the window to infinity or out of the image leaves nothing to follow (and a region of
+    # non-finite corners would be cast to INT_MIN, an empty image on which Lucas-Kanade never returns).
+    if not np.all(np.isfinite(predicted)) or np.any(predicted.max(0) < 0) or np.any(predicted.min(0) > image):
+        return None
     margin = max(w, h)
-    lo = np.floor(np.minimum(corners.min(0), predicted.min(0)) - margin).astype(int)
-    hi = np.ceil(np.maximum(corners.max(0), predicted.max(0)) + margin).astype(int)
-    x0, y0 = np.maximum(lo, 0)
-    x1, y1 = np.minimum(hi, [previous.shape[1], previous.shape[0]])
+    x0, y0 = np.clip(np.floor(np.minimum(corners.min(0), predicted.min(0)) - margin), 0, image).astype(int)
+    x1, y1 = np.clip(np.ceil(np.maximum(corners.max(0), predicted.max(0)) + margin), 0, image).astype(int)
     # Corners are searched in the window only; it lies inside the region, so its size check covers both.
     bx0, by0 = max(int(np.floor(x)), 0), max(int(np.floor(y)), 0)
     window = previous[by0:max(int(np.ceil(y + h)), by0), bx0:max(int(np.ceil(x + w)), bx0)]
@@ -67,7 +72,10 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
         return None
     points += np.array([bx0 - x0, by0 - y0], dtype=np.float32)
     offset = np.array([x0, y0], dtype=np.float32)
-    guess = points if prior is None else (map_points(prior, points.reshape(-1, 2) + offset) - offset)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        guess = points if prior is None else (map_points(prior, points.reshape(-1, 2) + offset) - offset)
+    if not np.all(np.isfinite(guess)):
+        return None
     guess = np.ascontiguousarray(guess, dtype=np.float32).reshape(-1, 1, 2)
     prev_roi, cur_roi = previous[y0:y1, x0:x1], current[y0:y1, x0:x1]
     moved, found, _ = cv2.calcOpticalFlowPyrLK(prev_roi, cur_roi, points, guess.copy(),

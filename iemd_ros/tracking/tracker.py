@@ -17,6 +17,7 @@ import cv2
 import numpy as np
 
 from iemd_ros.common.boxes import box_centre, centre_box, check_box
+from iemd_ros.common.limits import TARGET_SIDE
 from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, grey_levels, to_gray, window_axes
 from iemd_ros.tracking.candidate import CandidateModel, SearchContext, TargetModel
 from iemd_ros.tracking.colour_model import ColourModel
@@ -121,7 +122,8 @@ class IemdTracker:
         Raises
         ------
         ValueError
-            For a frame that is not such an image, or a box that is not finite, empty or outside the image.
+            For a frame that is not such an image, or a box that is not finite, empty, outside the image or larger
+            than it (:data:`~iemd_ros.common.limits.TARGET_SIDE`).
         """
         _check_frame(frame)
         x, y, w, h = _check_box(box, frame.shape)
@@ -516,6 +518,8 @@ def _check_box(box, shape):
     x, y, w, h = check_box(box)
     if x + w <= 0 or y + h <= 0 or x >= shape[1] or y >= shape[0]:
         raise ValueError(f"box {box!r} lies outside the {shape[1]}x{shape[0]} image")
+    TARGET_SIDE.check("box w", w, shape[1])
+    TARGET_SIDE.check("box h", h, shape[0])
     return x, y, w, h
 
 
