@@ -1,6 +1,7 @@
 """iemd-replay --out-dir: a folder or a list of bags replayed as one job per bag, in this process, on 2 local
 processes and on the test's Dask cluster (127.0.0.1); each CSV is the bytes a replay of that bag alone writes."""
 import os
+import shutil
 
 import pytest
 from bag_fixtures import make_bag, shaky_sequence
@@ -86,6 +87,17 @@ def test_one_box_for_every_bag_and_bags_listed_one_by_one(folder, tmp_path, alon
     assert sorted(p.name for p in out.iterdir()) == ["a.csv", "b.csv"]
     assert (out / "a.csv").read_bytes() == (alone / "a.csv").read_bytes()
     assert (out / "b.csv").read_bytes() != (alone / "b.csv").read_bytes()   # b started from a's box
+
+
+def test_a_bare_mcap_file_in_a_batch(folder, tmp_path, alone):
+    """A bare .mcap file (no metadata.yaml beside it), as open_bag reads it, is a bag of the batch too."""
+    d, boxes = folder
+    bare = tmp_path / "bare" / "a.mcap"
+    bare.parent.mkdir()
+    shutil.copy(next((d / "a").glob("*.mcap")), bare)
+    assert find_bags([bare]) == [bare]
+    assert main([str(bare), str(d / "b"), *_inits(boxes[:2]), "--out-dir", str(tmp_path / "out"), "--jobs", "1"]) == 0
+    assert (tmp_path / "out" / "a.csv").read_bytes() == (alone / "a.csv").read_bytes()
 
 
 def test_find_bags(folder, tmp_path):

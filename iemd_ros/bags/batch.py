@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from iemd_ros.bags.io import resolve_bag_path
+from iemd_ros.bags.io import bag_path
 from iemd_ros.bags.replay import ReplayResult, parse_box, replay
 from iemd_ros.common.cli import one_line
 from iemd_ros.common.parallel import Workers, run_jobs
@@ -41,8 +41,8 @@ def bags_in(folder: Path) -> list[Path]:
 
 
 def find_bags(inputs) -> list[Path]:
-    """The bags named by ``inputs``: each a bag (as :func:`~iemd_ros.bags.io.resolve_bag_path` takes it) or a
-    folder of bags (its rosbag2 folders and ``.bag`` files, in name order).
+    """The bags named by ``inputs``: each a bag (as :func:`~iemd_ros.bags.io.open_bag` takes it) or a folder of
+    bags (its rosbag2 folders and ``.bag`` files, in name order; a folder of bare ``.mcap`` files is not one).
 
     Parameters
     ----------
@@ -58,18 +58,18 @@ def find_bags(inputs) -> list[Path]:
     ------
     BagError
         For an input that does not exist, or a folder that is neither a bag nor holds one
-        (:func:`~iemd_ros.bags.io.resolve_bag_path`).
+        (:func:`~iemd_ros.bags.io.bag_path`).
     """
     found: list[Path] = []
     for item in inputs:
         path = Path(item)
-        bags = bags_in(path) or [resolve_bag_path(path)]
+        bags = bags_in(path) or [bag_path(path)]
         found.extend(b for b in bags if b not in found)
     return found
 
 
 def bag_name(bag: Path) -> str:
-    """A bag's name in the output folder: the rosbag2 folder's name, or the ``.bag`` file's stem.
+    """A bag's name in the output folder: the rosbag2 folder's name, or the ``.bag`` or ``.mcap`` file's stem.
 
     Parameters
     ----------
@@ -81,7 +81,7 @@ def bag_name(bag: Path) -> str:
     str
         The name.
     """
-    return bag.stem if bag.suffix == ".bag" else bag.name
+    return bag.stem if bag.is_file() and bag.suffix in (".bag", ".mcap") else bag.name
 
 
 @dataclass(frozen=True)

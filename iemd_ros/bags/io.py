@@ -30,7 +30,7 @@ from iemd_ros.messages.conversions import ns_to_stamp, raw_twin
 from iemd_ros.common.cli import one_line
 
 __all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "FORMATS",
-           "BagError", "BagMessages", "BagWriter", "Topics", "camera_info_fields", "custom_data", "deserialize",
+           "BagError", "BagMessages", "BagWriter", "Topics", "bag_path", "camera_info_fields", "custom_data", "deserialize",
            "header", "iter_messages", "open_bag", "resolve_bag_path", "ros1_typestore", "ros2_typestore",
            "salvage_mcap", "Salvage", "select_topics"]
 
@@ -317,6 +317,29 @@ def resolve_bag_path(path) -> Path:
     if p.is_dir() and not (p / "metadata.yaml").is_file():
         raise BagError(f"{p} is not a rosbag2 folder: it has no metadata.yaml")
     return p
+
+
+def bag_path(path) -> Path:
+    """The bag a path names, as :func:`open_bag` reads it: a lone mcap (a bare ``.mcap`` file, or a folder holding one
+    without ``metadata.yaml``) as given, else :func:`resolve_bag_path`'s path.
+
+    Parameters
+    ----------
+    path : str or path-like
+        What :func:`open_bag` takes.
+
+    Returns
+    -------
+    Path
+        The bag.
+
+    Raises
+    ------
+    BagError
+        As :func:`resolve_bag_path`.
+    """
+    p = Path(path)
+    return p if p.exists() and _lone_mcap(p) is not None else resolve_bag_path(p)
 
 
 def _lone_mcap(path: Path) -> Path | None:
