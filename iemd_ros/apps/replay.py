@@ -2,7 +2,7 @@
 
     iemd-replay BAG --init X,Y,W,H [--image-topic T] [--imu-topic T] [--camera-info-topic T] [--no-gyro]
                 --csv OUT.csv [--out-bag DIR] [--video OUT.mp4] [--gt FILE] [--config YAML]
-                [--camera-yaml FILE] [--time-offset-ms MS] [--progress | --no-progress]
+                [--camera-yaml FILE] [--time-offset-ms MS] [--read-ahead N] [--progress | --no-progress]
     iemd-replay BAG_OR_FOLDER [...] --init X,Y,W,H [--init ...] --out-dir DIR [--out-bags]
                 [--jobs N | --cluster tcp://HOST:8786] [the topic, gyro and config options]
 
@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from iemd_ros.bags.batch import RESULT_BAG_SUFFIX, bag_name, bags_in, find_bags, replay_batch, replay_jobs
-from iemd_ros.bags.replay import CSV_HEADER, ReplayResult, parse_box, replay
+from iemd_ros.bags.replay import CSV_HEADER, READ_AHEAD, ReplayResult, parse_box, replay
 from iemd_ros.common.cli import CliParser, cli_main, split_ros_args
 from iemd_ros.common.parallel import Workers, add_worker_arguments
 from iemd_ros.datasets.otb import parse_groundtruth
@@ -80,6 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="ROS camera_info YAML to use instead of the bag's camera info")
     p.add_argument("--time-offset-ms", type=float, default=None,
                    help="gyro time offset t_d (t_imu = t_cam + t_d); default from --config, else 0")
+    p.add_argument("--read-ahead", type=int, default=READ_AHEAD, metavar="N",
+                   help=f"messages read and decoded ahead of the tracker on a second thread (default {READ_AHEAD}; "
+                        "0: on the tracker's thread); the results are the same")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="progress bar on stderr (default: when stderr is a terminal)")
     batch = p.add_argument_group("batch (several bags, in parallel)")
@@ -155,6 +158,10 @@ def main(argv: list[str] | None = None) -> int:
         camera = CameraModel.from_yaml(a.camera_yaml) if a.camera_yaml else None
         options = dict(image_topic=a.image_topic, imu_topic=a.imu_topic, camera_info_topic=a.camera_info_topic,
                        config=cfg, use_gyro=not a.no_gyro, camera=camera)
+        if a.read_ahead < 0:
+            raise ValueError(f"--read-ahead {a.read_ahead}: give 0 or more messages")
+        if a.read_ahead != READ_AHEAD:
+            options["read_ahead"] = a.read_ahead
         return _one_bag(a, options) if a.out_dir is None else _batch(a, options)
 
     return cli_main("iemd-replay", body)
