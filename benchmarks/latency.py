@@ -1,6 +1,6 @@
 """Image-in to detection-out latency of the tracker node (p50 / p95), 640x480 at 30 Hz.
 
-    .venv/bin/python benchmarks/latency.py [--frames 150] [--rate 30] [--width 640 --height 480]
+    .venv/bin/python benchmarks/latency.py [--frames 150] [--rate 30] [--width 640 --height 480] [--targets 3]
 
 A driver node publishes a synthetic shaky-camera sequence (bgr8 frames, IMU at 200 Hz, CameraInfo)
 with sensor-data QoS, as a camera driver would, and times each frame from just before ``publish``
@@ -18,6 +18,9 @@ Detection2DArray at once (transport + rclpy overhead only).  Frames the tracker 
 keeps up with the newest frame) get no answer: "answered" is the fraction of published frames with
 a detection array, "delivered" the fraction that reached the node, "processed" and "dropped" the tracker's own
 counts (from its /diagnostics counters).  ``--rate 60`` gives more frames than the tracker can process.
+``--targets 3``: the tracker follows the target and two more regions of the scene beside it, added through ``~/init``
+with ids after the first frame; "targets" is the smallest number of detections in the arrays timed (frames from
+the fourth on).
 """
 from __future__ import annotations
 
@@ -86,8 +89,10 @@ def _run(args, seq, setup: str, subject: str) -> dict:
     from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
     from vision_msgs.msg import Detection2DArray
 
-    from iemd_ros.messages.conversions import (array_to_compressed_fields, compressed_topic, fill_image_msg, ns_to_stamp,
-                                      stamp_ns)
+    from vision_msgs.msg import Detection2D
+
+    from iemd_ros.messages.conversions import (array_to_compressed_fields, box_to_bbox, compressed_topic, fill_bbox,
+                                               fill_image_msg, ns_to_stamp, stamp_ns)
 
     env = dict(os.environ)             # the caller set FASTRTPS_DEFAULT_PROFILES_FILE for -shm
     box0 = [float(v) for v in seq.gt_boxes[0]]
@@ -124,8 +129,10 @@ def _run(args, seq, setup: str, subject: str) -> dict:
                    else drv.create_publisher(Image, "image", qos))
         imu_pub = drv.create_publisher(Imu, "imu", QoSProfile(depth=200, reliability=qos.reliability))
         info_pub = drv.create_publisher(CameraInfo, "camera_info", qos)
+        init_pub = drv.create_publisher(Detection2D, "/iemd_tracker/init", 10)
         sent: dict[int, int] = {}
         got: dict[int, int] = {}
+        counts: dict[int, int] = {}
         diag: dict = {}
         lock = threading.Lock()
 
@@ -133,6 +140,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
             t = time.perf_counter_ns()
             with lock:
                 got.setdefault(stamp_ns(msg.header), t)
+                counts.setdefault(stamp_ns(msg.header), len(msg.detections))
 
         def on_diag(msg):
             for st in msg.status:
@@ -171,6 +179,13 @@ def _run(args, seq, setup: str, subject: str) -> dict:
         gi = 0
         t0 = time.monotonic()
         for k, m in enumerate(msgs):
+            if k == 1 and subject == "tracker":        # the other targets, on the first frame (~/init by stamp)
+                x, y, w, h = box0
+                for j, box in enumerate([(x - 1.6 * w, y, w, h), (x, y + 1.4 * h, w, h)][:args.targets - 1]):
+                    det = Detection2D(id=f"target{j + 2}")
+                    det.header.stamp.sec, det.header.stamp.nanosec = ns_to_stamp(int(seq.frame_stamps_ns[0]))
+                    fill_bbox(det.bbox, box_to_bbox(box))
+                    init_pub.publish(det)
             time.sleep(max(0.0, t0 + k / args.rate - time.monotonic()))
             t_cam = int(seq.frame_stamps_ns[k])
             while gi < len(seq.gyro_t_ns) and seq.gyro_t_ns[gi] <= t_cam + 5_000_000:
@@ -196,7 +211,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
                 proc.communicate(timeout=10)
             except subprocess.TimeoutExpired:
                 proc.kill()
-    first = int(seq.frame_stamps_ns[1])    # frame 0 is the initialization frame
+    first = int(seq.frame_stamps_ns[3])    # frame 0 initializes, the other targets join on frame 1
     lat = np.array([(got[s] - t) / 1e6 for s, t in sent.items() if s in got and s >= first])
     n = sum(1 for s in sent if s >= first)
     delivered = (int(diag["frames_received"]) / len(sent)) if "frames_received" in diag else float("nan")
@@ -206,6 +221,7 @@ def _run(args, seq, setup: str, subject: str) -> dict:
                 p50=float(np.percentile(lat, 50)) if len(lat) else float("nan"),
                 p95=float(np.percentile(lat, 95)) if len(lat) else float("nan"),
                 proc=float(diag.get("tracking.processing_ms_mean", "nan")), sent=len(sent),
+                targets=min((c for s, c in counts.items() if s >= first), default=0),
                 processed=int(diag.get("frames_processed", -1)), dropped=int(diag.get("frames_dropped", -1)))
 
 
@@ -217,6 +233,7 @@ def main(argv=None) -> int:
     ap.add_argument("--height", type=int, default=480)
     ap.add_argument("--setups", default="inproc,process,process-shm,process-jpeg")
     ap.add_argument("--subjects", default="echo,tracker")
+    ap.add_argument("--targets", type=int, default=1, choices=(1, 2, 3), help="targets the tracker follows")
     ap.add_argument("--reliable", action="store_true", help="reliable QoS instead of sensor-data (best effort)")
     ap.add_argument("--serve-echo", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--compressed", action="store_true", help=argparse.SUPPRESS)
@@ -236,7 +253,7 @@ def main(argv=None) -> int:
     print(f"{args.frames} frames {args.width}x{args.height} bgr8 at {args.rate:.0f} Hz, "
           f"{'reliable' if args.reliable else 'sensor-data (best effort)'} QoS")
     print(f"{'setup':12s} {'subject':8s} {'delivered':>9s} {'answered':>8s} {'p50 ms':>7s} {'p95 ms':>7s} "
-          f"{'track ms':>8s} {'sent':>5s} {'processed':>9s} {'dropped':>7s}")
+          f"{'track ms':>8s} {'sent':>5s} {'processed':>9s} {'dropped':>7s} {'targets':>7s}")
     rows = []
     for setup in args.setups.split(","):
         for subject in args.subjects.split(","):
@@ -245,7 +262,8 @@ def main(argv=None) -> int:
             if setup == "process-shm":
                 env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(SHM_PROFILE)
             cmd = [sys.executable, __file__, "--measure", setup, subject, "--frames", str(args.frames),
-                   "--rate", str(args.rate), "--width", str(args.width), "--height", str(args.height)]
+                   "--rate", str(args.rate), "--width", str(args.width), "--height", str(args.height),
+                   "--targets", str(args.targets)]
             out = subprocess.run(cmd + (["--reliable"] if args.reliable else []), env=env, capture_output=True,
                                  text=True, timeout=600)
             lines = [ln for ln in out.stdout.splitlines() if ln.startswith("RESULT ")]
@@ -254,7 +272,8 @@ def main(argv=None) -> int:
                 return 1
             r = json.loads(lines[-1][7:])
             rows.append(r)
-            counted = (f"{r['processed']:9d} {r['dropped']:7d}" if subject == "tracker" else f"{'':9s} {'':7s}")
+            counted = (f"{r['processed']:9d} {r['dropped']:7d} {r['targets']:7d}" if subject == "tracker"
+                       else f"{'':9s} {'':7s} {'':7s}")
             print(f"{setup:12s} {subject:8s} {r['delivered']:9.0%} {r['answered']:8.0%} {r['p50']:7.1f} "
                   f"{r['p95']:7.1f} {r['proc']:8.1f} {r['sent']:5d} {counted}", flush=True)
     for setup in args.setups.split(","):

@@ -17,9 +17,10 @@ if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   "$venv/bin/python" -m pip install -q --disable-pip-version-check -r requirements.txt -c constraints.txt
   echo "$want" > "$stamp"
 fi
-# vision_msgs is neither on PyPI nor in common_interfaces: build the vendored 4.x
-# interface into the venv (no-op when it is up to date or a ROS install provides it).
-bash "$root/scripts/build_vision_msgs.sh" "$venv"
+# vision_msgs, tf2_msgs and foxglove_msgs have no PyPI wheel: build the vendored
+# interfaces into the venv (no-op when up to date or a ROS install provides them).
+bash "$root/scripts/build_interfaces.sh" "$venv"
 echo "[setup] installing iemd_ros into $venv"
 "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-deps --force-reinstall --no-build-isolation .
-"$venv/bin/python" -c "import iemd_ros" 
+# numba's cache beside the installed package: the first start of the node or iemd-replay compiles nothing
+(cd / && "$venv/bin/iemd-compile")

@@ -30,10 +30,11 @@ def stamp_header(header, t_ns: int, frame_id: str = FRAME_ID) -> None:
     header.stamp.sec, header.stamp.nanosec = ns_to_stamp(t_ns)
 
 
-def imu_msg(t_ns: int, w) -> Imu:
-    """A sensor_msgs/Imu stamped ``t_ns`` (frame "imu") with angular velocity ``w`` (3 values, rad/s)."""
+def imu_msg(t_ns: int, w, frame_id: str = FRAME_ID) -> Imu:
+    """A sensor_msgs/Imu stamped ``t_ns`` with angular velocity ``w`` (3 values, rad/s); the synthetic gyro measures
+    in the camera's frame, so its frame is the images' unless told."""
     msg = Imu()
-    stamp_header(msg.header, t_ns, "imu")
+    stamp_header(msg.header, t_ns, frame_id)
     msg.angular_velocity.x, msg.angular_velocity.y, msg.angular_velocity.z = (float(v) for v in w)
     return msg
 
@@ -142,15 +143,15 @@ class Driver:
             setattr(msg, name, value)
         self.image_pub.publish(msg)
 
-    def publish_imu(self, t_ns: int, w) -> None:
-        self.imu_pub.publish(imu_msg(t_ns, w))
+    def publish_imu(self, t_ns: int, w, frame_id: str = FRAME_ID) -> None:
+        self.imu_pub.publish(imu_msg(t_ns, w, frame_id))
 
-    def publish_imu_until(self, seq, t_cam_ns: int, sent: int = 0) -> int:
+    def publish_imu_until(self, seq, t_cam_ns: int, sent: int = 0, frame_id: str = FRAME_ID) -> int:
         """Publish ``seq``'s gyro samples from index ``sent`` up to the IMU time of the frame stamped
         ``t_cam_ns`` (+5 ms), as a real IMU stream would; returns the index of the next sample."""
         t_imu = t_cam_ns + seq.time_offset_ns + 5_000_000
         while sent < len(seq.gyro_t_ns) and seq.gyro_t_ns[sent] <= t_imu:
-            self.publish_imu(int(seq.gyro_t_ns[sent]), seq.gyro[sent])
+            self.publish_imu(int(seq.gyro_t_ns[sent]), seq.gyro[sent], frame_id)
             sent += 1
         return sent
 
@@ -163,10 +164,11 @@ class Driver:
         msg.distortion_model = "plumb_bob"
         self.info_pub.publish(msg)
 
-    def publish_init(self, box, t_ns: int) -> None:
+    def publish_init(self, box, t_ns: int, target_id: str = "") -> None:
         msg = Detection2D()
         stamp_header(msg.header, t_ns)
         fill_bbox(msg.bbox, box_to_bbox(box))
+        msg.id = target_id
         self.init_pub.publish(msg)
 
     # ---------------------------------------------------------------- services

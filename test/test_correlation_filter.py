@@ -1,76 +1,163 @@
-"""What the scale and the translation filter share (iemd_ros/correlation_filter.py)."""
+"""Features (fHOG, Colour Names) and the correlation filters' shared pieces against hand-computed cases, and STRCF's
+ADMM against a direct solve of its objective."""
 import numpy as np
 import pytest
+import scipy.fft as sfft
 
-from iemd_ros.tracking.correlation_filter import FLOOR, FilterModel, hann, model_size, orientation_histograms, parabola_peak
-
-
-def test_orientation_histograms_of_edges_by_hand():
-    """A vertical step edge 0 -> 1 between columns 3 and 4 of a 4x8 window: central differences give
-    0.5 at columns 3 and 4 (horizontal gradient, orientation 0: bin 0), so each 4x4 cell holds 4 x 0.5 = 2
-    in bin 0, divided by 2 + FLOOR.  The reversed edge falls in the same (unsigned) bin; a horizontal edge
-    (orientation 90 degrees) in bin 4 (20-degree bins); a diagonal ramp (45 degrees) in bin 2."""
-    step = np.zeros((4, 8), np.float32)
-    step[:, 4:] = 1.0
-    expected = np.zeros((2, 9))
-    expected[:, 0] = 2.0 / (2.0 + FLOOR)
-    out = orientation_histograms(np.stack([step, 1.0 - step]))
-    np.testing.assert_allclose(out, np.stack([expected.ravel()] * 2), rtol=1e-6)
-
-    horizontal = np.zeros((8, 4), np.float32)
-    horizontal[4:] = 1.0
-    assert np.flatnonzero(orientation_histograms(horizontal[None]).reshape(2, 9).sum(0)).tolist() == [4]
-    ramp = np.add.outer(np.arange(8.0), np.arange(8.0)).astype(np.float32)[None] / 16.0
-    assert np.flatnonzero(orientation_histograms(ramp).reshape(4, 9).sum(0)).tolist() == [2]
-    assert not orientation_histograms(np.full((1, 8, 8), 0.5, np.float32)).any()  # flat: no gradient, zeros
-    with pytest.raises(ValueError, match="multiple of the 4 px cell"):
-        orientation_histograms(np.zeros((1, 6, 8), np.float32))
+from iemd_ros.tracking import features as F
+from iemd_ros.tracking.correlation_filter import SubCellPeak, apce, gaussian_label, sample_region
+from iemd_ros.tracking.translation_filter import TranslationFilter
 
 
-def test_parabola_peak_by_hand():
-    """Samples of y = -(x - 0.25)^2 at -1, 0, 1 have their vertex at 0.25; a flat or convex triple gives 0."""
-    assert parabola_peak(-1.5625, -0.0625, -0.5625) == pytest.approx(0.25)
-    assert parabola_peak(1.0, 1.0, 1.0) == 0.0
-    assert parabola_peak(1.0, 0.0, 1.0) == 0.0
+def _grey3(a):
+    return np.repeat(np.clip(a, 0, 255).astype(np.uint8)[:, :, None], 3, axis=2)
 
 
-def test_filter_model_answers_its_training_sample_with_the_desired_response():
-    """One channel, one sample f with desired response g: H = G conj(F) / (|F|^2 + lambda), so the response
-    to f is G |F|^2 / (|F|^2 + lambda), g itself as lambda -> 0; a shifted sample shifts the response."""
+# ---------------------------------------------------------------------------------------------- fHOG
+def test_hog_of_a_ramp_by_hand():
+    """I = 10 x: every gradient (10, 0), angle 0.  An interior cell: R1[0] = 10 (16 px x 10 / 16), the other bins
+    0; E = 100, block norm 1 / sqrt(4 * 100) = 1/20, normalized 0.5, clipped 0.2: signed bin 0 = 0.5 * 4 * 0.2,
+    unsigned bin 0 the same, texture 0.2357 * 0.2, the rest 0."""
+    img = np.tile(np.arange(24, dtype=np.float32) * 10, (24, 1))
+    h = F.fhog(img)
+    assert h.shape == (31, 6, 6)
+    expect = np.zeros(31)
+    expect[0] = expect[18] = 0.4
+    expect[27:31] = 0.2357 * 0.2
+    np.testing.assert_allclose(h[:, 2, 2], expect, atol=1e-5)
+
+
+def test_hog_step_edges_fill_their_orientation_bins():
+    n = 32
+    img = np.zeros((n, n))
+    img[:, n // 2:] = 255                             # dark left, bright right: gradient +x, signed bin 0
+    cell = F.fhog(_grey3(img))[:, 4, 3]
+    assert np.argmax(cell[:18]) == 0 and np.argmax(cell[18:27]) == 0
+    assert cell[0] > 0.1 and cell[:18].sum() - cell[0] < 1e-6
+    cell = F.fhog(_grey3(255 - img))[:, 4, 3]         # 180 deg: signed bin 9, unsigned still 0
+    assert np.argmax(cell[:18]) == 9 and np.argmax(cell[18:27]) == 0
+
+
+@pytest.mark.parametrize("theta,signed,unsigned", [(40, 2, 2), (220, 11, 2), (100, 5, 5), (260, 13, 4), (347, 17, 8)])
+def test_hog_gradient_direction_goes_to_the_nearest_bin(theta, signed, unsigned):
+    """Bin k is centred on k x 20 deg (signed), on k x 20 deg mod 180 (unsigned)."""
+    yy, xx = np.mgrid[0:24, 0:24].astype(np.float32)
+    t = np.deg2rad(theta)
+    c = F.fhog(5.0 * (xx * np.cos(t) + yy * np.sin(t)) + 128)[:, 2, 2]
+    assert np.argmax(c[:18]) == signed and c[:18].sum() - c[signed] < 1e-6
+    assert np.argmax(c[18:27]) == unsigned and c[18:27].sum() - c[18 + unsigned] < 1e-6
+
+
+def test_hog_of_colour_takes_the_strongest_channel_and_a_flat_image_has_none():
+    img = np.zeros((24, 24, 3), np.uint8)
+    img[:, 12:, 2] = 200                              # a red vertical step
+    img[12:, :, 0] = 50                               # a weaker blue horizontal step
+    assert np.argmax(F.fhog(img)[:18, 2, 2]) == 0
+    assert np.abs(F.fhog(np.full((16, 16), 77, np.float32))).max() == 0
+
+
+# ---------------------------------------------------------------------------------------------- Colour Names
+def test_colour_names_cells_are_the_table_rows_of_their_pixels():
+    """Row of a BGR pixel b, g, r: r // 8 + 32 (g // 8) + 1024 (b // 8); a cell is the mean of its pixels' rows."""
+    table = F.colour_names()
+    assert table.shape == (32768, 10) and table.dtype == np.float32
+    patch = np.zeros((8, 8, 3), np.uint8)
+    patch[:, :4] = (8, 16, 24)                        # b=8, g=16, r=24: 3 + 2 * 32 + 1 * 1024 = 1091
+    patch[:, 4:] = (0, 0, 255)                        # pure red: 31
+    x = F.extract(patch, colour=True)
+    assert x.shape == (42, 2, 2)
+    np.testing.assert_allclose(x[32:, 0, 0], table[1091], atol=1e-6)
+    np.testing.assert_allclose(x[32:, 1, 1], table[31], atol=1e-6)
+    np.testing.assert_allclose(x[0, 0, 0], (0.299 * 24 + 0.587 * 16 + 0.114 * 8) / 255 - 0.5, atol=1e-6)
+    patch[0:2, 0:4] = (0, 0, 255)                     # half of the cell red
+    np.testing.assert_allclose(F.extract(patch, colour=True)[32:, 0, 0], 0.5 * table[1091] + 0.5 * table[31],
+                               atol=1e-6)
+
+
+def test_grey_frames_have_grey_and_hog_only():
     rng = np.random.default_rng(0)
-    sample = np.fft.fft(rng.normal(size=32))[None]  # (1 channel, 32)
-    desired = np.fft.fft(np.exp(-0.5 * ((np.arange(32) - 16) / 2.0) ** 2))
-    model = FilterModel(learning_rate=0.1, regularization=1e-9, channel_axis=0)
-    assert not model.trained
-    model.learn(desired, sample)
-    assert model.trained
-    np.testing.assert_allclose(np.fft.ifft(model.response(sample)).real, np.fft.ifft(desired).real, atol=1e-6)
-    shifted = sample * np.exp(-2j * np.pi * np.fft.fftfreq(32) * 5)  # the signal moved 5 samples on
-    assert int(np.argmax(np.fft.ifft(model.response(shifted)).real)) == 21
+    col = rng.integers(0, 256, (40, 48, 3), dtype=np.uint8)
+    x = F.extract(col, colour=True)
+    assert x.shape == (42, 10, 12) and F.n_channels(True) == 42
+    np.testing.assert_allclose(x[1:32], F.fhog(col), atol=1e-6)
+    grey = np.repeat(col[:, :, :1], 3, axis=2)
+    xg = F.extract(grey, colour=False)
+    assert xg.shape == (32, 10, 12) and F.n_channels(False) == 32
+    np.testing.assert_allclose(xg[1:], F.fhog(grey[:, :, 0]), atol=1e-6)
 
 
-def test_filter_model_keeps_running_averages_at_its_learning_rate():
-    """The first sample replaces the model, each later one is blended in at eta (DSST eq. 5); reset forgets."""
+# ---------------------------------------------------------------------------------------------- sampling, peak
+def test_sample_region_crops_exactly_and_turns_by_the_angle():
     rng = np.random.default_rng(1)
-    desired = np.fft.fft(rng.normal(size=16))
-    first, second = (np.fft.fft(rng.normal(size=(3, 16)), axis=1) for _ in range(2))
-    model = FilterModel(learning_rate=0.25, regularization=0.01, channel_axis=0)
-    model.learn(desired, first)
-    model.learn(desired, second)
-    numerator = 0.75 * desired * np.conj(first) + 0.25 * desired * np.conj(second)
-    denominator = 0.75 * (np.abs(first) ** 2).sum(0) + 0.25 * (np.abs(second) ** 2).sum(0)
-    probe = np.fft.fft(rng.normal(size=(3, 16)), axis=1)
-    np.testing.assert_allclose(model.response(probe), (numerator * probe).sum(0) / (denominator + 0.01))
-    model.reset()
-    assert not model.trained
-    with pytest.raises(ValueError, match="learning_rate"):
-        FilterModel(learning_rate=0.0, regularization=0.01, channel_axis=0)
+    img = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8)
+    same = sample_region(img, (40, 30), (20, 10), (20, 10))
+    np.testing.assert_array_equal(same, img[25:35, 30:50])            # [round(cx) - w // 2, ... + w)
+    half = sample_region(img, (40, 30), (40, 20), (20, 10))
+    np.testing.assert_allclose(half, img[20:40, 20:60].reshape(10, 2, 20, 2, 3).mean(axis=(1, 3)), atol=1)
+    quarter = sample_region(img, (40.0, 30.0), (21, 21), (21, 21), np.pi / 2)  # a turn by 90 deg: transposed
+    np.testing.assert_array_equal(quarter, img[20:41, 30:51].transpose(1, 0, 2)[::-1])  # sample[v, u] = img[20 + u, 50 - v]
 
 
-def test_model_size_and_taper_by_hand():
-    """100 x 50 px to about 512 px: scaled by sqrt(512 / 5000) = 0.32 to 32 x 16, whole 4-px cells; a tiny window
-    keeps min_cells cells per axis.  The taper has no zero ends and peaks in the middle."""
-    assert model_size((100.0, 50.0), 512, min_cells=2) == (32, 16)
-    assert model_size((4.0, 400.0), 512, min_cells=2) == (8, 228)
-    taper = hann(5)
-    np.testing.assert_allclose(taper, [0.25, 0.75, 1.0, 0.75, 0.25])
+def test_the_sub_cell_peak_of_a_shifted_gaussian():
+    rows, cols, dy0, dx0 = 20, 24, 3.3, -4.6
+    yy, xx = np.mgrid[0:rows, 0:cols]
+    d2 = ((yy - dy0 + rows / 2) % rows - rows / 2) ** 2 + ((xx - dx0 + cols / 2) % cols - cols / 2) ** 2
+    resp = np.exp(-0.5 * d2 / 4.0)
+    dy, dx, _ = SubCellPeak(rows, cols)(resp, sfft.rfft2(resp))
+    assert abs(dy - dy0) < 0.02 and abs(dx - dx0) < 0.02 and apce(resp) > 10
+
+
+# ---------------------------------------------------------------------------------------------- STRCF's solver
+def _tiny(rows, cols, C, seed=0):
+    rng = np.random.default_rng(seed)
+    x = rng.standard_normal((C, rows, cols))
+    y = gaussian_label(rows, cols, 1.0).astype(np.float64)
+    w2 = rng.uniform(0.0, 4.0, (rows, cols))
+    w2[rows // 2 - 1:rows // 2 + 1, cols // 2 - 1:cols // 2 + 1] = 1e-6
+    f_prev = rng.standard_normal((C, rows, cols)) * 0.1
+    tf = TranslationFilter()
+    tf.map_hw, tf.T, tf.reg_sq = (rows, cols), rows * cols, w2
+    tf.yf_conj = np.conj(sfft.rfft2(y))
+    return tf, x, y, w2, f_prev
+
+
+def _correlation_matrix(x):
+    """A (T, C T) with (A f)(n) = sum_d sum_m f_d(m) x_d(m + n) (circular): the response of f on x."""
+    C, R, Cc = x.shape
+    T = R * Cc
+    A = np.zeros((T, C * T))
+    for n in range(T):
+        ny, nx = divmod(n, Cc)
+        for d in range(C):
+            A[n, d * T:(d + 1) * T] = np.roll(np.roll(x[d], -ny, axis=0), -nx, axis=1).ravel()
+    return A
+
+
+@pytest.mark.parametrize("rows,cols", [(6, 6), (5, 7)])
+def test_admm_converges_to_the_direct_solve_of_strcf_objective(rows, cols):
+    """argmin 1/(2T) ||sum_d x_d * f_d - y||^2 + 1/2 sum_d ||w f_d||^2 + mu/2 sum_d ||f_d - f_prev||^2, by the
+    normal equations, against ADMM run long at a fixed penalty; and the response convention r = A f."""
+    C, mu = 2, 0.7
+    tf, x, y, w2, f_prev = _tiny(rows, cols, C)
+    T = rows * cols
+    A = _correlation_matrix(x)
+    lhs = A.T @ A / T + np.diag(np.tile(w2.ravel(), C)) + mu * np.eye(C * T)
+    f_direct = np.linalg.solve(lhs, A.T @ y.ravel() / T + mu * f_prev.ravel()).reshape(C, rows, cols)
+    f_hat = tf._admm(sfft.rfft2(x), sfft.rfft2(f_prev), iterations=3000, gamma=(1.0, 1.0, 1.0), mu=mu)
+    np.testing.assert_allclose(sfft.irfft2(f_hat, s=(rows, cols)), f_direct, atol=2e-4 * np.abs(f_direct).max())
+    r = sfft.irfft2(np.sum(np.conj(sfft.rfft2(f_direct)) * sfft.rfft2(x), axis=0), s=(rows, cols))
+    np.testing.assert_allclose(r.ravel(), A @ f_direct.ravel(), atol=1e-9)
+
+
+def test_the_first_f_step_is_the_per_frequency_solve():
+    """One f-step from g = h = 0, mu = 0: (x x^H + T gamma I) f = x conj(y) at every frequency (Sherman-Morrison)."""
+    rows, cols, C = 4, 6, 3
+    tf, x, y, _, _ = _tiny(rows, cols, C)
+    xf = sfft.rfft2(x)
+    f_hat = tf._admm(xf, None, iterations=1, gamma=(2.0, 1.0, 2.0))
+    yf = sfft.rfft2(y)
+    for i in range(rows):
+        for j in range(cols // 2 + 1):
+            a = xf[:, i, j]
+            ref = np.linalg.solve(np.outer(a, np.conj(a)) + rows * cols * 2.0 * np.eye(C), a * np.conj(yf[i, j]))
+            np.testing.assert_allclose(f_hat[:, i, j], ref, rtol=1e-6, atol=1e-9)

@@ -136,7 +136,6 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
     "argv, match",
     [
         (["--trackers", "nope"], "unknown tracker 'nope'"),
-        (["--sequences", "NoSuchSeq", "--trackers", "kcf"], "unknown sequence 'NoSuchSeq'"),
         (["--max-frames", "zero", "--trackers", "kcf"], "not an integer"),
         (["--jobs", "0", "--trackers", "kcf"], "--jobs must be >= 1, got 0"),
         (["--jobs", "2", "--cluster", "tcp://127.0.0.1:9", "--trackers", "kcf"], "not allowed with"),
@@ -149,6 +148,13 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
 )
 def test_bad_arguments_exit_2_one_line(argv, match, capsys):
     assert match in cli_error(main, argv, capsys, "iemd-eval: error:")
+
+
+def test_unknown_sequence_exits_2_one_line(tmp_path, capsys):
+    """An unknown --sequences name is an argument error (a root of its own: no ../shared needed)."""
+    root, _ = _synthetic_root(tmp_path)
+    argv = [str(root), "--sequences", "NoSuchSeq", "--trackers", "kcf"]
+    assert "unknown sequence 'NoSuchSeq'" in cli_error(main, argv, capsys, "iemd-eval: error:")
 
 
 def test_bad_argument_subprocess_no_traceback(tmp_path):

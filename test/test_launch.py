@@ -58,7 +58,7 @@ def test_node_is_the_packages_tracker_executable_named_as_its_parameter_file_say
     setup = ast.parse((REPO / "setup.py").read_text())
     executables = next(ast.literal_eval(n.value) for n in ast.walk(setup)
                        if isinstance(n, ast.Assign) and getattr(n.targets[0], "id", "") == "EXECUTABLES")
-    assert node.get("exec") in executables and executables[node.get("exec")] == "iemd_ros.ros.node"
+    assert node.get("exec") in executables and executables[node.get("exec")] == ("iemd_ros.ros.node", "main")
     assert node.get("name") == NODE_NAME
     (params,) = [p for p in node.iter("param") if p.get("from")]
     params_file = REPO.joinpath(_resolve(params.get("from"), args))

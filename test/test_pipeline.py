@@ -320,3 +320,68 @@ def test_config_from_yaml_reads_the_node_parameter_file_nested_or_dotted(tmp_pat
     (tmp_path / "latin1.yaml").write_bytes("tracker: {n_iter: 10}  # caf\xe9\n".encode("latin-1"))
     with pytest.raises(ValueError, match="cannot read config .*latin1.yaml"):
         PipelineConfig.from_yaml(tmp_path / "latin1.yaml")
+
+
+def test_several_targets_share_one_rotation_per_frame(seq, monkeypatch):
+    """Three targets by id: one result each, the default target's boxes identical to tracking it alone, and one
+    rotation integrated per frame for all (the window stamps agree while all are tracked)."""
+    p, stamps = _started(seq)
+    alone, _ = _started(seq)
+    x, y, w, h = (float(v) for v in seq.gt_boxes[0])
+    p.init(seq.frames[0], (x - 60.0, y, 40.0, 40.0), stamps[0], "left")
+    p.init(seq.frames[0], (x, y + 50.0, 40.0, 40.0), stamps[0], "below")
+    assert p.targets == ["", "left", "below"] and p.state is TrackState.TRACKING
+    integrations = []
+    buffer_integrate = type(p._predictor.buffer).integrate
+    monkeypatch.setattr(type(p._predictor.buffer), "integrate",
+                        lambda self, *a, **k: (self is p._predictor.buffer and integrations.append(a[:2]))
+                        or buffer_integrate(self, *a, **k))
+    for k in range(1, 8):
+        results = p.process_all(seq.frames[k], stamps[k])
+        assert [r.target_id for r in results] == ["", "left", "below"]
+        assert all(r.gyro_used for r in results)
+        assert results[0] == replace_ms(alone.process(seq.frames[k], stamps[k]), results[0].processing_ms)
+    assert len(integrations) == 7 and len(set(integrations)) == 7       # once per frame, not once per target
+    with pytest.raises(ValueError, match="process_all"):
+        p.process(seq.frames[8], stamps[8])
+    assert p.drop("left") and not p.drop("left") and p.targets == ["", "below"]
+    assert p.target_state("below") is TrackState.TRACKING and p.target_state("left") is TrackState.UNINITIALIZED
+    r = p.init(seq.frames[8], (x, y + 50.0, 30.0, 30.0), stamps[8], "below")    # replaces the one of that id
+    assert r.is_init and r.target_id == "below" and p.targets == ["", "below"]
+    d = p.diagnostics()
+    assert d["targets"] == "(default): tracking, below: tracking"
+    p.reset()
+    assert p.targets == [] and p.state is TrackState.UNINITIALIZED
+    (r,) = p.process_all(seq.frames[9], stamps[9])
+    assert r.state is TrackState.UNINITIALIZED and r.box is None
+
+
+def replace_ms(result, ms):
+    """``result`` with ``processing_ms`` set (the one wall-clock field)."""
+    from dataclasses import replace
+
+    return replace(result, processing_ms=ms)
+
+
+def test_extrinsic_from_tf_replaces_the_parameter_and_rebuilds_with_the_samples(seq):
+    from iemd_ros.gyro.rotation import so3_exp
+    from iemd_ros.pipeline import ExtrinsicSource
+
+    p, stamps = _started(seq)
+    assert p.extrinsic[0] is ExtrinsicSource.PARAMETER
+    n_samples = len(p._predictor.buffer)
+    R = so3_exp([0.0, 0.0, np.pi / 2])
+    assert p.set_extrinsic(R, "imu_link", "cam") and not p.set_extrinsic(R, "imu_link", "cam")
+    source, used = p.extrinsic
+    assert source is ExtrinsicSource.TF and np.allclose(used, R) and len(p._predictor.buffer) == n_samples
+    r_turned = p.process(seq.frames[1], stamps[1])
+    assert r_turned.gyro_used
+    assert p.set_extrinsic(None, "imu_link", "cam") and p.extrinsic[0] is ExtrinsicSource.PARAMETER
+    assert np.allclose(p.extrinsic[1], np.eye(3))
+    st = {s.part.value: s for s in p.statuses()}["imu"]
+    assert st.level is Level.WARN and "no transform" in st.message and st.values["imu_frame"] == "imu_link"
+    with pytest.raises(ValueError, match="proper 3x3 rotation"):
+        p.set_extrinsic(np.diag([1.0, 1.0, -1.0]))
+    q, _ = _started(seq)
+    q.set_extrinsic(None, "cam", "cam")                          # one frame: nothing to relate, no warning
+    assert {s.part.value: s for s in q.statuses()}["imu"].level is Level.OK

@@ -22,8 +22,8 @@ from iemd_ros.common.cli import split_ros_args
 from iemd_ros.evaluation.metrics import iou, score_sequence
 from iemd_ros.apps.replay import main
 from iemd_ros.pipeline import Rejection
-from iemd_ros.bags.replay import CSV_HEADER, DETECTIONS_TOPIC, DIAGNOSTICS_TOPIC, READ_AHEAD, parse_box, read_ahead, \
-    replay
+from iemd_ros.bags.replay import (ANNOTATIONS_TOPIC, CSV_HEADER, DEBUG_IMAGE_TOPIC, DETECTIONS_TOPIC,
+                                  DIAGNOSTICS_TOPIC, READ_AHEAD, parse_box, read_ahead, replay)
 from iemd_ros.messages.conversions import stamp_ns
 
 N = 10
@@ -84,6 +84,20 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
         else:
             assert d.detections == []                          # lost: no detection, as the node
     assert {s.name for s in diags[-1].status} >= {"iemd_tracker: tracking", "iemd_tracker: imu"}
+    # the overlay Foxglove draws (issue #26): an ImageAnnotations per image at its stamp, the box as a closed line
+    # of its corners, and the annotated frame as a JPEG CompressedImage beside it
+    notes, jpegs = by_topic(out, ANNOTATIONS_TOPIC), by_topic(out, DEBUG_IMAGE_TOPIC)
+    assert len(notes) == len(jpegs) == N
+    np.testing.assert_array_equal(stamps(jpegs), seq.frame_stamps_ns)
+    for note, r in zip(notes, rows[1:]):
+        (loop,) = note.points
+        assert loop.timestamp.sec * 10**9 + loop.timestamp.nanosec == int(r[0]) and len(note.texts) == 1
+        x, y, w, h = (float(v) for v in r[1:5])
+        np.testing.assert_allclose([(p.x, p.y) for p in loop.points],
+                                   [(x - .5, y - .5), (x + w - .5, y - .5), (x + w - .5, y + h - .5),
+                                    (x - .5, y + h - .5)], atol=1e-9)
+    assert jpegs[0].format == "bgr8; jpeg compressed bgr8"       # image_transport's compressed naming
+    assert cv2.imdecode(np.asarray(jpegs[0].data, np.uint8), cv2.IMREAD_COLOR).shape == (240, 320, 3)
     cap = cv2.VideoCapture(str(tmp_path / "v.mp4"))
     assert int(cap.get(cv2.CAP_PROP_FRAME_COUNT)) == N and abs(cap.get(cv2.CAP_PROP_FPS) - 30.0) < 0.5
     ok, frame = cap.read()
@@ -115,8 +129,9 @@ def _diagnostics_but_wall_clock(path) -> list:
 
 @pytest.mark.parametrize("depth", [1, 3, READ_AHEAD])
 def test_read_ahead_replays_as_the_serial_loop(seq, bags, tmp_path, depth):
-    """Decoding ahead on a thread gives the serial replay's CSV byte for byte, the same detection messages byte for
-    byte, and the same diagnostics but for the update times measured on the wall clock."""
+    """Decoding ahead on a thread gives the serial replay's CSV byte for byte, the same detection and annotation
+    messages byte for byte, and the same diagnostics and debug images but for the update times measured on the
+    wall clock."""
     init = _init(seq)
     serial = replay(bags / "shaky", init, csv_path=tmp_path / "s.csv", out_bag=tmp_path / "s_out", read_ahead=0)
     ahead = replay(bags / "shaky", init, csv_path=tmp_path / "a.csv", out_bag=tmp_path / "a_out", read_ahead=depth)
@@ -124,6 +139,9 @@ def test_read_ahead_replays_as_the_serial_loop(seq, bags, tmp_path, depth):
     assert [r.box for r in ahead.results] == [r.box for r in serial.results] and len(serial.results) == N
     s, a = _raw_by_topic(tmp_path / "s_out"), _raw_by_topic(tmp_path / "a_out")
     assert a[DETECTIONS_TOPIC] == s[DETECTIONS_TOPIC] and len(s[DETECTIONS_TOPIC]) == N
+    assert a[ANNOTATIONS_TOPIC] == s[ANNOTATIONS_TOPIC]
+    # the debug image prints the update's wall-clock ms on the frame, so its JPEG differs between serial runs too
+    assert [t for t, _ in a[DEBUG_IMAGE_TOPIC]] == [t for t, _ in s[DEBUG_IMAGE_TOPIC]]
     assert [t for t, _ in a[DIAGNOSTICS_TOPIC]] == [t for t, _ in s[DIAGNOSTICS_TOPIC]]
     assert _diagnostics_but_wall_clock(tmp_path / "a_out") == _diagnostics_but_wall_clock(tmp_path / "s_out")
     assert ahead.diagnostics["gyro_used"] == serial.diagnostics["gyro_used"] > 0

@@ -1,75 +1,44 @@
-"""The DSST scale filter (iemd_ros/scale_filter.py) and the tracker's use of it."""
+"""The fDSST scale filter (iemd_ros/tracking/scale_filter.py) and the tracker's use of it."""
 import numpy as np
 import pytest
 from helpers import zoomed
 
 from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.tracking.appearance import ImagePyramid, to_gray
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking.scale_filter import ScaleFilter
 
 
-def test_the_scaled_windows_are_the_windows_sampled_one_by_one(car4_first):
+@pytest.mark.parametrize("angle", [0.0, 0.6])
+def test_recovers_a_known_scale_change_of_a_real_window(car4_first, angle):
+    """Learned on Car4's target, the filter measures the target against windows 10 % too small or too large
+    (1/0.9 = 1.111 and 1/1.1 = 0.909), and against a frame magnified by 6 %; with the window turned too."""
     frame, box = car4_first
-    pyramid = ImagePyramid(to_gray(frame))
-    factors = 1.02 ** np.arange(-2, 3)  # these share the unscaled window's anti-aliasing level
-    for angle in (0.0, 0.6):
-        stacked = pyramid.sample_scales(box_centre(box), box[2:], (24, 20), factors, angle)
-        one_by_one = [pyramid.sample(box_centre(box), box[2:] * f, (24, 20), angle) for f in factors]
-        np.testing.assert_allclose(stacked, np.stack(one_by_one), atol=1e-4)
-
-
-def test_recovers_a_known_scale_change_of_a_real_window(car4_first):
-    """Learned on Car4's target, the filter measures the target against windows 10 % too small or too
-    large (1/0.9 = 1.111 and 1/1.1 = 0.909), and against a frame magnified by 6 %."""
-    frame, box = car4_first
-    pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(box), box[2:]
-    scale_filter = ScaleFilter()
-    scale_filter.init(pyramid, centre, size)
-    assert scale_filter.estimate(pyramid, centre, size) == pytest.approx(1.0, abs=1e-9)
+    centre, size = box_centre(box), box[2:]
+    sf = ScaleFilter()
+    sf.init(frame, centre, size, angle)
+    assert sf.estimate(frame, centre, size, angle) == pytest.approx(1.0, abs=0.005)
     for window in (0.9, 1.1):
-        assert scale_filter.estimate(pyramid, centre, size * window) == pytest.approx(1.0 / window, rel=0.025)
-    bigger = ImagePyramid(to_gray(zoomed(frame, centre, 1.06)))
-    assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.06, rel=0.015)
+        assert sf.estimate(frame, centre, size * window, angle) == pytest.approx(1.0 / window, rel=0.03)
+    assert sf.estimate(zoomed(frame, centre, 1.06), centre, size, angle) == pytest.approx(1.06, rel=0.015)
 
 
-def test_update_learns_at_the_estimated_scale(car4_first):
-    """update() learns the last estimate's sample with its desired response centred on the estimated
-    scale: after learning the 6 % larger target, that target is measured at scale 1 from its own size."""
+def test_the_estimate_stays_within_the_bounds_and_update_learns_the_new_size(car4_first):
     frame, box = car4_first
-    pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(box), box[2:]
-    scale_filter = ScaleFilter(learning_rate=1.0)  # the new sample replaces the filter
-    scale_filter.init(pyramid, centre, size)
-    bigger = ImagePyramid(to_gray(zoomed(frame, centre, 1.06)))
-    scale = scale_filter.estimate(bigger, centre, size)
-    scale_filter.update()
-    assert scale_filter.estimate(bigger, centre, size * scale) == pytest.approx(1.0, abs=0.01)
-    scale_filter.update()
-    with pytest.raises(RuntimeError, match="needs an estimate"):  # each estimate is learned at most once
-        scale_filter.update()
-
-
-def test_update_learns_at_the_scale_the_tracker_took(car4_first):
-    """An estimate limited by ``bounds`` (the tracker's bounds on the window) is what update() learns: told that
-    the 6 % larger target may be at most at scale 1, the filter then measures it at scale 1 from the original
-    window's size."""
-    frame, box = car4_first
-    pyramid, centre, size = ImagePyramid(to_gray(frame)), box_centre(box), box[2:]
-    scale_filter = ScaleFilter(learning_rate=1.0)
-    scale_filter.init(pyramid, centre, size)
-    bigger = ImagePyramid(to_gray(zoomed(frame, centre, 1.06)))
-    assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.06, rel=0.015)
-    assert scale_filter.estimate(bigger, centre, size, bounds=(0.5, 1.0)) == pytest.approx(1.0, abs=1e-12)
-    scale_filter.update()
-    assert scale_filter.estimate(bigger, centre, size) == pytest.approx(1.0, abs=0.01)
+    centre, size = box_centre(box), box[2:]
+    sf = ScaleFilter()
+    sf.init(frame, centre, size)
+    bigger = zoomed(frame, centre, 1.06)
+    assert sf.estimate(bigger, centre, size, bounds=(0.5, 1.0)) == 1.0
+    for _ in range(40):  # the running template learns the larger target at its larger size
+        sf.update(bigger, centre, size * 1.06)
+    assert sf.estimate(bigger, centre, size * 1.06) == pytest.approx(1.0, abs=0.01)
 
 
 def test_invalid_use_is_refused():
-    with pytest.raises(RuntimeError, match="before init"):
-        ScaleFilter().estimate(ImagePyramid(np.zeros((64, 64), np.float32)), (32, 32), (16, 16))
-    for kwargs, message in [({"n_scales": 4}, "odd"), ({"scale_step": 1.0}, "> 1"), ({"learning_rate": 0}, "learning_rate must be")]:
-        with pytest.raises(ValueError, match=message):
-            ScaleFilter(**kwargs)
+    with pytest.raises(RuntimeError, match="needs init"):
+        ScaleFilter().estimate(np.zeros((64, 64), np.uint8), (32, 32), (16, 16))
+    with pytest.raises(ValueError, match="> 1"):
+        ScaleFilter(scale_step=1.0)
     with pytest.raises(ValueError, match="scale_estimator must be one of filter, emd"):
         TrackerConfig(scale_estimator="dsst")
 

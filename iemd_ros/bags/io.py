@@ -49,7 +49,7 @@ class BagError(ValueError):
 
 
 def ros2_typestore():
-    """ROS 2 Jazzy typestore with the vision_msgs definitions registered.
+    """ROS 2 Jazzy typestore with the vision_msgs and foxglove_msgs definitions registered.
 
     Returns
     -------
@@ -58,10 +58,11 @@ def ros2_typestore():
     """
     from rosbags.typesys import Stores, get_typestore
 
-    from iemd_ros.bags.types import vision_msgs_types
+    from iemd_ros.bags.types import VENDORED, interface_types
 
     ts = get_typestore(Stores.ROS2_JAZZY)
-    ts.register(vision_msgs_types())
+    for package in VENDORED:
+        ts.register(interface_types(package))
     return ts
 
 

@@ -17,8 +17,10 @@ the node does with its ``initial_box``.
 Outputs: the CSV (:data:`CSV_HEADER`, one row per image, floats in shortest round-trip form; the init frame's row
 holds the init box with state ``init`` and an empty emd; a frame the pipeline could not use has an empty box and
 state ``rejected``/``malformed``; ``held`` is 1 on a tracked frame whose models did not learn), optionally a rosbag2
-(mcap) with ``vision_msgs/Detection2DArray`` and ``diagnostic_msgs/DiagnosticArray`` stamped and logged like the
-images (open it in Foxglove next to the input), and an annotated MP4 (``mp4v``).
+(mcap) with ``vision_msgs/Detection2DArray``, the ``foxglove_msgs/ImageAnnotations`` overlay, the annotated frame as a
+JPEG ``sensor_msgs/CompressedImage`` and ``diagnostic_msgs/DiagnosticArray``, stamped and logged like the images (open
+it in Foxglove: the Image panel shows the debug image, or the input's image with the annotations drawn over it), and
+an annotated MP4 (``mp4v``).
 """
 from __future__ import annotations
 
@@ -40,19 +42,22 @@ from iemd_ros.bags.io import BagError, BagMessages, BagWriter, Topics, deseriali
 from iemd_ros.common.boxes import check_box
 from iemd_ros.common.progress import Progress
 from iemd_ros.gyro import CameraModel
-from iemd_ros.messages.conversions import CLASS_ID, DETECTION_ID, camera_model_from_msg, image_from_msg, \
-    imu_sample, stamp_ns
-from iemd_ros.messages.outputs import DETECTIONS_TYPE, DIAGNOSTICS_TYPE, detection_array, diagnostic_array, header
+from iemd_ros.messages.conversions import CLASS_ID, DETECTION_ID, array_to_compressed_fields, \
+    camera_model_from_msg, image_from_msg, imu_sample, stamp_ns
+from iemd_ros.messages.outputs import ANNOTATIONS_TYPE, COMPRESSED_IMAGE_TYPE, DETECTIONS_TYPE, DIAGNOSTICS_TYPE, \
+    detection_array, diagnostic_array, header, image_annotations
 from iemd_ros.pipeline import FrameResult, ImuWait, PipelineConfig, TrackingPipeline, TrackState
-from iemd_ros.pipeline.drawing import draw_result
+from iemd_ros.pipeline.drawing import box_colour, draw_result
 
 __all__ = ["Replay", "ReplayResult", "replay", "parse_box", "write_csv", "read_ahead", "CSV_HEADER", "READ_AHEAD",
-           "DETECTIONS_TOPIC", "DIAGNOSTICS_TOPIC"]
+           "DETECTIONS_TOPIC", "DIAGNOSTICS_TOPIC", "ANNOTATIONS_TOPIC", "DEBUG_IMAGE_TOPIC"]
 
 CSV_HEADER = ("stamp_ns", "x", "y", "w", "h", "emd", "state", "held")
 # as the node publishes them (``detections`` in the root namespace, class_id "target", id "iemd")
 DETECTIONS_TOPIC = "/detections"
 DIAGNOSTICS_TOPIC = "/diagnostics"
+ANNOTATIONS_TOPIC = "/iemd_tracker/annotations"
+DEBUG_IMAGE_TOPIC = "/iemd_tracker/debug_image/compressed"
 HARDWARE_ID = "iemd_replay"
 
 
@@ -191,19 +196,28 @@ def write_csv(path, results: list[FrameResult]) -> None:
 
 # ---------------------------------------------------------------------------------------------- outputs
 class _OutBag:
-    """Detections + diagnostics rosbag2 (mcap), stamped and logged like the images."""
+    """Detections, annotations, the annotated frame (JPEG) and diagnostics as a rosbag2 (mcap), stamped and logged
+    like the images."""
 
     def __init__(self, path, frame_topic: str):
         self.bag = BagWriter(path, "mcap", {"iemd_ros.replay_of": frame_topic})
         self.bag.__enter__()
-        self.bag.add_topic(DETECTIONS_TOPIC, DETECTIONS_TYPE)
-        self.bag.add_topic(DIAGNOSTICS_TOPIC, DIAGNOSTICS_TYPE)
+        for topic, msgtype in ((DETECTIONS_TOPIC, DETECTIONS_TYPE), (ANNOTATIONS_TOPIC, ANNOTATIONS_TYPE),
+                               (DEBUG_IMAGE_TOPIC, COMPRESSED_IMAGE_TYPE), (DIAGNOSTICS_TOPIC, DIAGNOSTICS_TYPE)):
+            self.bag.add_topic(topic, msgtype)
         self.make = BagMessages(self.bag)
 
-    def write(self, log_t: int, frame_id: str, r: FrameResult, statuses) -> None:
-        """The frame's Detection2DArray (one detection while ``r`` is tracking, else empty) and its statuses."""
+    def write(self, log_t: int, frame_id: str, r: FrameResult, statuses, image: np.ndarray | None) -> None:
+        """The frame's Detection2DArray (one detection while ``r`` is tracking, else empty), its annotations, its
+        drawing (when the frame decoded) and its statuses."""
         hdr = header(self.make, r.stamp_ns, frame_id)
-        self.bag.write(DETECTIONS_TOPIC, log_t, detection_array(self.make, hdr, r, CLASS_ID, DETECTION_ID))
+        self.bag.write(DETECTIONS_TOPIC, log_t, detection_array(self.make, hdr, [r], CLASS_ID, DETECTION_ID))
+        self.bag.write(ANNOTATIONS_TOPIC, log_t, image_annotations(self.make, r.stamp_ns, [r], DETECTION_ID,
+                                                                   box_colour))
+        if image is not None:
+            fields = array_to_compressed_fields(draw_result(image, r), "jpeg")
+            fields["data"] = np.frombuffer(fields["data"], np.uint8)
+            self.bag.write(DEBUG_IMAGE_TOPIC, log_t, self.make(COMPRESSED_IMAGE_TYPE, header=hdr, **fields))
         rows = [(s.name("iemd_tracker"), s.level, s.message, s.values) for s in statuses]
         self.bag.write(DIAGNOSTICS_TOPIC, log_t, diagnostic_array(self.make, hdr, rows, HARDWARE_ID))
 
@@ -546,7 +560,7 @@ class Replay:
     def _emit(self, f: _Frame, r: FrameResult) -> None:
         self._results.append(r)
         if self._out is not None:
-            self._out.write(f.log_t, f.frame_id, r, self.pipeline.statuses())
+            self._out.write(f.log_t, f.frame_id, r, self.pipeline.statuses(), f.image)
         if self._video is not None and f.image is not None:
             self._video.write(f.image, r)
         self._bar.update(1, r.state.value)

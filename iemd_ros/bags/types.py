@@ -1,17 +1,18 @@
 """Message definitions for rosbags typestores (bag I/O, no rclpy).
 
-rosbags ships the core ROS 2 message types but not vision_msgs. ``vision_msgs_types()`` parses the
-vision_msgs 4.x ``.msg`` definitions into the dict that ``Typestore.register`` takes, so bags with
-``vision_msgs/msg/Detection2DArray`` (the tracker's output) can be written and read without ROS:
+rosbags ships the core ROS 2 message types but not vision_msgs or foxglove_msgs. :func:`interface_types` parses a
+package's ``.msg`` definitions into the dict that ``Typestore.register`` takes, so bags with
+``vision_msgs/msg/Detection2DArray`` (the tracker's output) or ``foxglove_msgs/msg/ImageAnnotations`` (its overlay)
+can be written and read without ROS:
 
     from rosbags.typesys import Stores, get_typestore
-    from iemd_ros.bags.types import vision_msgs_types
+    from iemd_ros.bags.types import interface_types
     typestore = get_typestore(Stores.ROS2_JAZZY)
-    typestore.register(vision_msgs_types())
+    typestore.register(interface_types("vision_msgs"))
 
-The definitions are read, in this order, from an explicit folder, from ``share/vision_msgs/msg`` of
-an installed vision_msgs (the prefixes in AMENT_PREFIX_PATH, then this interpreter's prefix, where
-scripts/build_vision_msgs.sh installs it), or from the repository's ``interfaces/vision_msgs/msg``.
+The definitions are read, in this order, from an explicit folder, from ``share/<package>/msg`` of an installed
+package (the prefixes in AMENT_PREFIX_PATH, then this interpreter's prefix, where scripts/build_interfaces.sh
+installs it), or from the repository's ``interfaces/<package>/msg``.
 """
 from __future__ import annotations
 
@@ -19,28 +20,40 @@ import os
 import sys
 from pathlib import Path
 
-PACKAGE = "vision_msgs"
-REPO_MSG_DIR = Path(__file__).resolve().parents[1] / "interfaces" / PACKAGE / "msg"
+__all__ = ["VENDORED", "msg_dirs", "find_msg_dir", "interface_types", "vision_msgs_types"]
+
+REPO_INTERFACES = Path(__file__).resolve().parents[2] / "interfaces"
+VENDORED = ("vision_msgs", "foxglove_msgs")  # vendored packages whose types rosbags lacks
 
 
-def vision_msgs_msg_dirs() -> list[Path]:
-    """Candidate folders of vision_msgs ``.msg`` files, most authoritative first.
+def msg_dirs(package: str) -> list[Path]:
+    """Candidate folders of a package's ``.msg`` files, most authoritative first.
+
+    Parameters
+    ----------
+    package : str
+        The interface package.
 
     Returns
     -------
     list of Path
-        ``share/vision_msgs/msg`` of each prefix in AMENT_PREFIX_PATH and of this interpreter's prefix, then the
-        repository's ``interfaces/vision_msgs/msg``.
+        ``share/<package>/msg`` of each prefix in AMENT_PREFIX_PATH and of this interpreter's prefix, then the
+        repository's ``interfaces/<package>/msg``.
     """
     prefixes = [Path(p) for p in os.environ.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
     prefixes.append(Path(sys.prefix))
-    dirs = [prefix / "share" / PACKAGE / "msg" for prefix in prefixes]
-    dirs.append(REPO_MSG_DIR)
+    dirs = [prefix / "share" / package / "msg" for prefix in prefixes]
+    dirs.append(REPO_INTERFACES / package / "msg")
     return dirs
 
 
-def find_vision_msgs_msg_dir() -> Path:
-    """First folder of ``vision_msgs_msg_dirs()`` that holds ``.msg`` files.
+def find_msg_dir(package: str) -> Path:
+    """First folder of :func:`msg_dirs` that holds ``.msg`` files.
+
+    Parameters
+    ----------
+    package : str
+        The interface package.
 
     Returns
     -------
@@ -52,21 +65,22 @@ def find_vision_msgs_msg_dir() -> Path:
     FileNotFoundError
         When none holds them.
     """
-    searched = vision_msgs_msg_dirs()
+    searched = msg_dirs(package)
     for folder in searched:
         if folder.is_dir() and any(folder.glob("*.msg")):
             return folder
-    raise FileNotFoundError(
-        "no vision_msgs .msg definitions found; searched: " + ", ".join(map(str, searched)))
+    raise FileNotFoundError(f"no {package} .msg definitions found; searched: " + ", ".join(map(str, searched)))
 
 
-def vision_msgs_types(msg_dir: str | os.PathLike | None = None) -> dict:
-    """Parse every ``vision_msgs/msg/*.msg`` into ``{type name: definition}`` for rosbags.
+def interface_types(package: str, msg_dir: str | os.PathLike | None = None) -> dict:
+    """Parse every ``<package>/msg/*.msg`` into ``{type name: definition}`` for rosbags.
 
     Parameters
     ----------
+    package : str
+        The interface package.
     msg_dir : str or path-like, optional
-        Folder of the ``.msg`` files; default ``find_vision_msgs_msg_dir()``.
+        Folder of the ``.msg`` files; default ``find_msg_dir(package)``.
 
     Returns
     -------
@@ -83,16 +97,31 @@ def vision_msgs_types(msg_dir: str | os.PathLike | None = None) -> dict:
     from rosbags.typesys import get_types_from_msg
 
     if msg_dir is None:
-        folder = find_vision_msgs_msg_dir()
+        folder = find_msg_dir(package)
     else:
         folder = Path(msg_dir)
         if not folder.is_dir():
-            raise ValueError(f"vision_msgs msg folder {folder} is not a directory")
+            raise ValueError(f"{package} msg folder {folder} is not a directory")
     files = sorted(folder.glob("*.msg"))
     if not files:
-        raise ValueError(f"vision_msgs msg folder {folder} holds no .msg file")
+        raise ValueError(f"{package} msg folder {folder} holds no .msg file")
     types: dict = {}
     for path in files:
-        types.update(get_types_from_msg(path.read_text(encoding="utf-8"),
-                                        f"{PACKAGE}/msg/{path.stem}"))
+        types.update(get_types_from_msg(path.read_text(encoding="utf-8"), f"{package}/msg/{path.stem}"))
     return types
+
+
+def vision_msgs_types(msg_dir: str | os.PathLike | None = None) -> dict:
+    """:func:`interface_types` of vision_msgs.
+
+    Parameters
+    ----------
+    msg_dir : str or path-like, optional
+        Folder of the ``.msg`` files.
+
+    Returns
+    -------
+    dict
+        Type name -> definition.
+    """
+    return interface_types("vision_msgs", msg_dir)

@@ -434,6 +434,28 @@ class GyroPredictor:
         ValueError
             Without a camera model.
         """
+        return self.at_box(self.homography(t_prev_ns, t_cur_ns), box)
+
+    def homography(self, t_prev_ns: int, t_cur_ns: int) -> GyroPrediction:
+        """The box-free part of :meth:`predict`: the rotation and ``K R^T K^-1`` between two frames.
+
+        Integrated once per frame pair, it serves every target of the frame (:meth:`at_box`).
+
+        Parameters
+        ----------
+        t_prev_ns, t_cur_ns : int
+            Camera stamps of frames k-1 and k, ns.
+
+        Returns
+        -------
+        GyroPrediction
+            With the global ``H`` as prior and no box; without a prior when the gyro gives no usable rotation.
+
+        Raises
+        ------
+        ValueError
+            Without a camera model.
+        """
         if self.camera is None:
             raise ValueError("no camera model: the gyro prior needs K")
         integ = self.rotation(t_prev_ns, t_cur_ns)
@@ -441,14 +463,31 @@ class GyroPredictor:
         if not usable:
             return GyroPrediction(integ, None, None, None, None, f"no gyro prior: {integ.reason}")
         H = rotation_homography(self.camera.K, integ.R, self.camera.K_inv)
-        if box is None:
-            return GyroPrediction(integ, integ.R, H, H, None, integ.reason)
-        try:
-            prior, res, pbox = _prior_and_box(box, H, self.camera)
-        except ValueError as exc:       # box far outside the lens model's valid region
-            return GyroPrediction(integ, integ.R, H, None, None, f"no gyro prior at this box: {exc}")
-        return GyroPrediction(integ, integ.R, H, prior, pbox, integ.reason, res)
+        return GyroPrediction(integ, integ.R, H, H, None, integ.reason)
 
+    def at_box(self, global_prediction: GyroPrediction, box=None) -> GyroPrediction:
+        """:meth:`homography`'s prediction fitted at ``box`` (frame k-1): the local prior and the predicted box.
+
+        Parameters
+        ----------
+        global_prediction : GyroPrediction
+            What :meth:`homography` gave for the frame pair.
+        box : array_like, optional
+            (x, y, w, h) in frame k-1 (None: ``global_prediction`` as it is).
+
+        Returns
+        -------
+        GyroPrediction
+            Without a prior when there is no rotation or the box lies outside the lens model.
+        """
+        g = global_prediction
+        if box is None or g.H is None:
+            return g
+        try:
+            prior, res, pbox = _prior_and_box(box, g.H, self.camera)
+        except ValueError as exc:       # box far outside the lens model's valid region
+            return GyroPrediction(g.integration, g.R, g.H, None, None, f"no gyro prior at this box: {exc}")
+        return GyroPrediction(g.integration, g.R, g.H, prior, pbox, g.reason, res)
 
 def warm_up() -> None:
     """Compile the gyro path's numba kernels now (or load them from numba's on-disk cache).

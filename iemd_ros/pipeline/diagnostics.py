@@ -26,6 +26,7 @@ class Part(enum.Enum):
     IMAGE = "image input"
     IMU = "imu"
     CAMERA = "camera_info"
+    OUTPUT = "detections"  # the published detections' rate and stamp age (the node's, pipeline.topic_status)
 
 
 @dataclass(frozen=True)
@@ -85,14 +86,15 @@ def statuses(d: dict) -> list[Status]:
 
     return [
         Status(Part.TRACKING, *_tracking(d), vals(
-            "state", "held", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
+            "state", "targets", "held", "emd", "iterations", "lost_run", "frames_lost", "frames_held", "processing_ms_mean",
             "processing_ms_max", "processing_rate_hz", "inits", "resets", "updates_abandoned", "frame_reason")),
         Status(Part.IMAGE, *_image(d), vals(
             "frames_received", "frames_processed", "frames_dropped", "frames_rejected", "images_malformed",
             "input_rate_hz", "processing_rate_hz", "recent_dropped", "image_error", "drop_reason", "clock_resets")),
         Status(Part.IMU, *_imu(d), vals(
             "imu_received", "imu_rejected", "imu_out_of_order", "imu_saturated", "imu_stored", "imu_pending",
-            "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status")),
+            "gyro_used", "gyro_unused", "recent_gyro_used", "gyro_reason", "imu_reason", "bias_status",
+            "extrinsic_source", "imu_frame", "camera_frame", "R_cam_imu")),
         Status(Part.CAMERA, *_camera(d), vals("camera", "camera_infos", "camera_infos_rejected", "camera_error",
                                               "camera_misfit")),
     ]
@@ -131,6 +133,9 @@ def _imu(d: dict) -> tuple[Level, str]:
         return Level.WARN, "no IMU message received: tracking without the gyro prior"
     if d["imu_bad_run"]:
         return Level.WARN, d["imu_reason"]
+    if d["frames_unrelated"] and d["parameter_is_identity"]:
+        return Level.WARN, (f"the IMU frame '{d['imu_frame']}' is not the image's '{d['camera_frame']}' and no "
+                            "transform between them is known (TF): using gyro.R_cam_imu, the identity")
     if d["recent_processed"] and d["last_gyro_used"] is False:
         return Level.WARN, f"latest frame tracked without the gyro prior: {d['gyro_reason']}"
     return Level.OK, f"gyro prior used on {d['recent_gyro_used']} of the last {d['recent_processed']} frames"

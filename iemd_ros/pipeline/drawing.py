@@ -6,17 +6,14 @@ import numpy as np
 
 from iemd_ros.pipeline.results import FrameResult
 
-__all__ = ["draw_result"]
+__all__ = ["draw_result", "draw_results", "box_colour"]
 
 # BGR
 TRACKING, LOST, INIT, GYRO = (0, 200, 0), (0, 0, 255), (255, 200, 0), (0, 220, 255)
 
 
 def draw_result(frame: np.ndarray, r: FrameResult) -> np.ndarray:
-    """A tracking result drawn on a BGR copy of its frame.
-
-    The box (green tracking, red lost, light blue on the init frame), the gyro's predicted box (thin, yellow) and a line
-    with the stamp and state.
+    """A tracking result drawn on a BGR copy of its frame (:func:`draw_results` of one result).
 
     Parameters
     ----------
@@ -30,14 +27,53 @@ def draw_result(frame: np.ndarray, r: FrameResult) -> np.ndarray:
     ndarray
         The HxWx3 BGR drawing.
     """
+    return draw_results(frame, [r])
+
+
+def box_colour(r: FrameResult) -> tuple[int, int, int]:
+    """The BGR colour of a result's box: light blue on the init frame, green tracking, red lost or rejected.
+
+    Parameters
+    ----------
+    r : FrameResult
+        The result.
+
+    Returns
+    -------
+    tuple of int
+        B, G, R.
+    """
+    return INIT if r.is_init else TRACKING if r.tracking else LOST
+
+
+def draw_results(frame: np.ndarray, results) -> np.ndarray:
+    """The results of one frame (one per target) drawn on a BGR copy of it.
+
+    Each box (:func:`box_colour`), the gyro's predicted box (thin, yellow) and a line per result with the stamp and
+    state (and the target's id when there are several).
+
+    Parameters
+    ----------
+    frame : ndarray
+        HxW grey or HxWx3 BGR uint8 frame.
+    results : sequence of FrameResult
+        The frame's results.
+
+    Returns
+    -------
+    ndarray
+        The HxWx3 BGR drawing.
+    """
     img = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR) if frame.ndim == 2 else frame.copy()
-    if r.gyro_box is not None:
-        _rect(img, r.gyro_box, GYRO, 1)
-    if r.box is not None:
-        _rect(img, r.box, INIT if r.is_init else TRACKING if r.tracking else LOST, 2)
-    text = f"{r.stamp_ns / 1e9:.3f}s {_status(r)}"
-    cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 3, cv2.LINE_AA)
-    cv2.putText(img, text, (5, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA)
+    for i, r in enumerate(results):
+        if r.gyro_box is not None:
+            _rect(img, r.gyro_box, GYRO, 1)
+        if r.box is not None:
+            _rect(img, r.box, box_colour(r), 2)
+        label = f"[{r.target_id}] " if len(results) > 1 else ""
+        text = f"{label}{r.stamp_ns / 1e9:.3f}s {_status(r)}"
+        for colour, thickness in (((0, 0, 0), 3), ((255, 255, 255), 1)):
+            cv2.putText(img, text, (5, 18 + 18 * i), cv2.FONT_HERSHEY_SIMPLEX, 0.5, colour, thickness, cv2.LINE_AA)
     return img
 
 

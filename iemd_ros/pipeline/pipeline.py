@@ -11,6 +11,11 @@ The one place where per-message data flows into :class:`~iemd_ros.tracking.IemdT
     result = pipe.process(frame, t_ns)           # FrameResult, once ImuWait lets the frame go
     statuses(pipe.diagnostics())                 # OK/WARN/ERROR summaries for /diagnostics
 
+Several targets: ``init(frame, box, t_ns, target_id="car")`` adds a target (or restarts the one of that id),
+``drop("car")`` forgets one, ``reset()`` all; :meth:`TrackingPipeline.process_all` tracks every target into a frame
+and returns one FrameResult per target.  The targets share the IMU buffer, and the gyro rotation between two frames is
+integrated once for all of them (only the local fit of the prior is per box).
+
 Gyro prior (paper, section 5.2): the rotation is integrated from the frame whose window the tracker holds -- the
 init frame or the last frame that was not lost (a lost frame leaves the window where it was) -- to the new frame,
 and the lens-aware ``K R^T K^-1`` prior is fitted at that window.
@@ -29,34 +34,87 @@ import math
 import threading
 import time
 from collections import deque
+from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
 from iemd_ros.gyro import CameraModel, GyroPredictor
+from iemd_ros.gyro.frames import frame_name
 from iemd_ros.gyro.imu import SampleStatus
 from iemd_ros.gyro.predictor import warm_up as warm_up_gyro
 from iemd_ros.pipeline.config import PipelineConfig
 from iemd_ros.pipeline.diagnostics import Status, rate_hz, statuses
-from iemd_ros.pipeline.results import INIT_REASON, FrameResult, Rejection, TrackState
+from iemd_ros.pipeline.results import DEFAULT_TARGET, INIT_REASON, ExtrinsicSource, FrameResult, Rejection, TrackState
 from iemd_ros.pipeline.watchdog import Abandoned, Watchdog
 from iemd_ros.tracking import IemdTracker
 from iemd_ros.tracking.tracker import warm_up as warm_up_tracker
 
-__all__ = ["TrackingPipeline"]
+__all__ = ["TrackingPipeline", "warm_up_kernels", "kernels_cached", "kernel_cache_dir"]
 
 _WINDOW = 30  # recent frames / IMU messages the diagnostics look at
 
 
+def kernel_cache_dir() -> Path:
+    """Where numba caches the kernels: the ``__pycache__`` folders of the installed package (its root here).
+
+    Returns
+    -------
+    Path
+        The package's folder.
+    """
+    return Path(__file__).resolve().parents[1]
+
+
+def kernels_cached() -> bool:
+    """Whether numba's cache beside the package holds kernels already (else the first pipeline of a process compiles
+    them, 10-30 s).
+
+    Returns
+    -------
+    bool
+        True when a cache index is there.
+    """
+    return any(kernel_cache_dir().glob("*/__pycache__/*.nbi"))
+
+
 @functools.cache
-def _warm_up_once() -> None:
-    """The tracker's and the gyro's numba kernels, compiled once per process at the first pipeline's start-up (not
-    on the first frames)."""
+def warm_up_kernels() -> bool:
+    """The tracker's and the gyro's numba kernels, compiled (or loaded from numba's cache) once per process, at the
+    first pipeline's start-up, not on the first frames.
+
+    Returns
+    -------
+    bool
+        Whether they were in the cache already.
+    """
+    cached = kernels_cached()
     warm_up_tracker()
     warm_up_gyro()
+    return cached
 
 
 def _ms(ns: float) -> str:
     return f"{ns / 1e6:.1f} ms"
+
+
+class _Target:
+    """One target's tracker state: the tracker, the window it holds and its state."""
+
+    def __init__(self, target_id: str, tracker: IemdTracker, ref: tuple[int, tuple, np.ndarray]):
+        self.id = target_id
+        self.tracker = tracker
+        self.ref = ref                      # (stamp, window box, frame) the window is in
+        self.state = TrackState.TRACKING
+        self.lost_run = 0
+        self.last_result: FrameResult | None = None
+
+    def restart(self, config) -> None:
+        """A new tracker at the window it holds, on the frame that window belongs to."""
+        _, box, frame = self.ref
+        self.tracker = IemdTracker(config)
+        self.tracker.init(frame, box)
+        self.state, self.lost_run = TrackState.TRACKING, 0
 
 
 class TrackingPipeline:
@@ -79,18 +137,17 @@ class TrackingPipeline:
     """
 
     def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
-        _warm_up_once()
+        warm_up_kernels()
         self._cfg = config if config is not None else PipelineConfig()
         if not isinstance(self._cfg, PipelineConfig):
             raise ValueError("config must be a PipelineConfig")
         self._lock = threading.RLock()        # IMU / camera / counters (held briefly)
         self._track_lock = threading.RLock()  # tracker state (held during a tracker update)
-        self._predictor = GyroPredictor(None, self._cfg.gyro)   # buffers the IMU from the start; K comes later
-        self._tracker: IemdTracker | None = None
-        self._state = TrackState.UNINITIALIZED
-        self._ref: tuple[int, tuple, np.ndarray] | None = None   # (stamp, window box, frame) the window is in
+        self._tf_rotation: np.ndarray | None = None  # camera-IMU rotation from TF (None: gyro.R_cam_imu)
+        self._frames = ("", "")                      # (IMU frame, camera frame) as the messages name them
+        self._predictor = GyroPredictor(None, self._gyro_config())  # buffers the IMU from the start; K comes later
+        self._targets: dict[str, _Target] = {}
         self._last_stamp: int | None = None
-        self._lost_run = 0
         self.counters = dict(frames_received=0, frames_processed=0, frames_uninitialized=0, frames_dropped=0,
                              frames_rejected=0, images_malformed=0, frames_lost=0, frames_held=0, gyro_used=0, gyro_unused=0,
                              imu_received=0, imu_rejected=0, imu_out_of_order=0, imu_saturated=0,
@@ -99,7 +156,7 @@ class TrackingPipeline:
         self._last = dict(frame_reason="", gyro_reason="", imu_reason="", image_error="", camera_error="",
                           drop_reason="", camera_misfit="", watchdog_reason="")
         self._watchdog = Watchdog()
-        self._last_result: FrameResult | None = None
+        self._last_result: FrameResult | None = None   # the latest tracked result of any target
         self._image_bad = False          # the latest image message was malformed
         self._stamp_rejected = False     # the latest frame was rejected for its stamp
         self._imu_bad_run = 0            # consecutive rejected IMU messages
@@ -116,8 +173,38 @@ class TrackingPipeline:
 
     @property
     def state(self) -> TrackState:
-        """The tracking state."""
-        return self._state
+        """The tracking state: uninitialized without a target, tracking while any target is tracked, else lost."""
+        with self._lock:
+            return self._overall_state()
+
+    def _overall_state(self) -> TrackState:
+        states = {t.state for t in self._targets.values()}
+        if not states:
+            return TrackState.UNINITIALIZED
+        return TrackState.TRACKING if TrackState.TRACKING in states else TrackState.LOST
+
+    @property
+    def targets(self) -> list[str]:
+        """The ids of the targets, in the order they were added."""
+        with self._lock:
+            return list(self._targets)
+
+    def target_state(self, target_id: str) -> TrackState:
+        """The state of one target (uninitialized when there is no such target).
+
+        Parameters
+        ----------
+        target_id : str
+            The target's id.
+
+        Returns
+        -------
+        TrackState
+            Its state.
+        """
+        with self._lock:
+            target = self._targets.get(target_id)
+            return TrackState.UNINITIALIZED if target is None else target.state
 
     @property
     def camera(self) -> CameraModel | None:
@@ -155,14 +242,10 @@ class TrackingPipeline:
                 self._rebuild_predictor()
                 notes.append("gyro predictor rebuilt (IMU samples kept)")
             if config.tracker != old.tracker:
-                if self._tracker is not None and self._ref is not None:
-                    stamp, box, frame = self._ref
-                    self._tracker = IemdTracker(config.tracker)
-                    self._tracker.init(frame, box)
-                    self._state, self._lost_run = TrackState.TRACKING, 0
-                    notes.append("tracker restarted at its current window")
-                else:
-                    notes.append("tracker configuration stored")
+                for target in self._targets.values():
+                    target.restart(config.tracker)
+                notes.append("tracker restarted at its current window" if self._targets else
+                             "tracker configuration stored")
             return "; ".join(notes) or "no change"
 
     # ------------------------------------------------------------------ inputs
@@ -318,7 +401,57 @@ class TrackingPipeline:
 
     def _new_predictor(self) -> GyroPredictor:
         """An empty GyroPredictor for the current camera and gyro configuration."""
-        return GyroPredictor(self._predictor.camera, self._cfg.gyro)
+        return GyroPredictor(self._predictor.camera, self._gyro_config())
+
+    def _gyro_config(self):
+        """``gyro.*`` with the camera-IMU rotation from TF when one is known."""
+        if self._tf_rotation is None:
+            return self._cfg.gyro
+        return replace(self._cfg.gyro, R_cam_imu=tuple(float(v) for v in np.clip(self._tf_rotation, -1, 1).ravel()))
+
+    def set_extrinsic(self, rotation, imu_frame: str = "", camera_frame: str = "") -> bool:
+        """Use the camera-IMU rotation found between the IMU's and the image's frames (TF) instead of
+        ``gyro.R_cam_imu``; None goes back to the parameter.
+
+        A changed rotation rebuilds the gyro predictor, keeping the buffered IMU samples (they are integrated in
+        the camera frame through it).
+
+        Parameters
+        ----------
+        rotation : array_like or None
+            3x3 orientation of the IMU frame in the camera frame (``w_cam = R w_imu``), or None.
+        imu_frame, camera_frame : str, optional
+            The frames as the messages name them (the diagnostics say which they are).
+
+        Returns
+        -------
+        bool
+            True when the rotation in use changed.
+
+        Raises
+        ------
+        ValueError
+            For a rotation that is not a proper 3x3 rotation matrix.
+        """
+        R = None if rotation is None else np.asarray(rotation, dtype=float)
+        if R is not None and (R.shape != (3, 3) or not np.allclose(R @ R.T, np.eye(3), atol=1e-6)
+                              or np.linalg.det(R) < 0):
+            raise ValueError(f"the camera-IMU rotation must be a proper 3x3 rotation, got {np.asarray(rotation).tolist()}")
+        with self._lock:
+            self._frames = (str(imu_frame), str(camera_frame))
+            old = self._tf_rotation
+            if (old is None and R is None) or (old is not None and R is not None and np.array_equal(old, R)):
+                return False
+            self._tf_rotation = R
+            self._rebuild_predictor()
+            return True
+
+    @property
+    def extrinsic(self) -> tuple[ExtrinsicSource, np.ndarray]:
+        """Where the camera-IMU rotation in use comes from, and the rotation."""
+        with self._lock:
+            source = ExtrinsicSource.PARAMETER if self._tf_rotation is None else ExtrinsicSource.TF
+            return source, self._predictor.calibration.R_cam_imu.copy()
 
     def note_dropped(self, stamp_ns: int, reason: str = "a newer frame arrived before this one was processed") -> None:
         """Count a frame the caller skipped (e.g. stale: processing fell behind).
@@ -359,7 +492,7 @@ class TrackingPipeline:
             if stamp_ns is None:
                 return None
             self._recent.append((int(stamp_ns), "malformed"))
-            return FrameResult(stamp_ns=int(stamp_ns), state=self._state, rejection=Rejection.MALFORMED,
+            return FrameResult(stamp_ns=int(stamp_ns), state=self._overall_state(), rejection=Rejection.MALFORMED,
                                reason=f"malformed: {reason}")
 
     # ------------------------------------------------------------------ tracking
@@ -380,12 +513,14 @@ class TrackingPipeline:
             Whether the frame may go now.
         """
         with self._lock:
-            if not self._cfg.use_gyro or self._predictor.camera is None or self._ref is None:
+            if not self._cfg.use_gyro or self._predictor.camera is None or not self._targets:
                 return True
             return self._predictor.ready(int(stamp_ns))
 
-    def init(self, frame: np.ndarray, box, stamp_ns: int) -> FrameResult:
+    def init(self, frame: np.ndarray, box, stamp_ns: int, target_id: str = DEFAULT_TARGET) -> FrameResult:
         """(Re)start tracking the target ``box`` in ``frame`` stamped ``stamp_ns``.
+
+        A new ``target_id`` adds a target; an existing one is restarted on this box (the other targets go on).
 
         Parameters
         ----------
@@ -395,6 +530,8 @@ class TrackingPipeline:
             (x, y, w, h), 0-based top-left corner and size in pixels.
         stamp_ns : int
             The frame's stamp, camera clock, ns.
+        target_id : str, optional
+            The target's id (default :data:`DEFAULT_TARGET`).
 
         Returns
         -------
@@ -404,34 +541,49 @@ class TrackingPipeline:
         Raises
         ------
         ValueError
-            For a bad frame or box (the previous target, if any, is kept then).
+            For a bad frame or box (the previous target of that id, if any, is kept then), or an id that is not text.
         """
+        if not isinstance(target_id, str):
+            raise ValueError(f"target_id must be text, got {target_id!r}")
         with self._track_lock:
             tracker = IemdTracker(self._cfg.tracker)
             tracker.init(frame, box)
             box = tuple(float(v) for v in box)
             with self._lock:
-                self._tracker = tracker
-                self._ref = (int(stamp_ns), box, frame)
-                self._state, self._lost_run = TrackState.TRACKING, 0
+                self._targets[target_id] = _Target(target_id, tracker, (int(stamp_ns), box, frame))
                 self.counters["inits"] += 1
                 self._last["frame_reason"] = self._last["watchdog_reason"] = ""
                 if self._last_stamp is None or int(stamp_ns) > self._last_stamp:
                     self._last_stamp = int(stamp_ns)
         return FrameResult(stamp_ns=int(stamp_ns), state=TrackState.TRACKING, box=box, score=1.0, reason=INIT_REASON,
-                           is_init=True)
+                           is_init=True, target_id=target_id)
+
+    def drop(self, target_id: str) -> bool:
+        """Forget one target; the others go on.
+
+        Parameters
+        ----------
+        target_id : str
+            The target's id.
+
+        Returns
+        -------
+        bool
+            False when there was no such target.
+        """
+        with self._track_lock, self._lock:
+            return self._targets.pop(target_id, None) is not None
 
     def reset(self) -> None:
-        """Forget the target (state "uninitialized"); IMU and camera are kept."""
+        """Forget every target (state "uninitialized"); IMU and camera are kept."""
         with self._track_lock, self._lock:
-            self._tracker, self._ref = None, None
-            self._state, self._lost_run = TrackState.UNINITIALIZED, 0
+            self._targets.clear()
             self._last_result = None
             self._last["watchdog_reason"] = ""
             self.counters["resets"] += 1
 
     def process(self, frame: np.ndarray, stamp_ns: int) -> FrameResult:
-        """Track into ``frame``.
+        """Track the one target into ``frame`` (:meth:`process_all` for several).
 
         Parameters
         ----------
@@ -444,6 +596,32 @@ class TrackingPipeline:
         -------
         FrameResult
             The frame's result; see :class:`FrameResult`.
+
+        Raises
+        ------
+        ValueError
+            For a bad frame, or when there are several targets.
+        """
+        results = self.process_all(frame, stamp_ns)
+        if len(results) != 1:
+            raise ValueError(f"process() tracks one target, there are {len(results)}: use process_all()")
+        return results[0]
+
+    def process_all(self, frame: np.ndarray, stamp_ns: int) -> list[FrameResult]:
+        """Track every target into ``frame``.
+
+        Parameters
+        ----------
+        frame : ndarray
+            HxW or HxWx3 (BGR) uint8 frame.
+        stamp_ns : int
+            The frame's stamp, camera clock, ns.
+
+        Returns
+        -------
+        list of FrameResult
+            One per target, in the order of :attr:`targets`; a single result (without a box) when the frame is
+            rejected for its stamp or there is no target.
 
         Raises
         ------
@@ -461,54 +639,69 @@ class TrackingPipeline:
                     self.counters["frames_rejected"] += 1
                     self._recent.append((t, "rejected"))
                     self._last["frame_reason"] = rejected
-                    return FrameResult(stamp_ns=t, state=self._state, rejection=Rejection.STAMP, reason=rejected)
+                    return [FrameResult(stamp_ns=t, state=self._overall_state(), rejection=Rejection.STAMP,
+                                        reason=rejected)]
                 self._last_stamp = t
-                if self._tracker is None:
+                if not self._targets:
                     self.counters["frames_uninitialized"] += 1
                     self._recent.append((t, "uninitialized"))
-                    return FrameResult(stamp_ns=t, state=TrackState.UNINITIALIZED,
-                                       reason="no target: waiting for an initial box")
-                prior, gyro_box, gyro_reason = self._gyro_prior(t, frame)
+                    return [FrameResult(stamp_ns=t, state=TrackState.UNINITIALIZED,
+                                        reason="no target: waiting for an initial box")]
+                targets = list(self._targets.values())
+                priors = self._gyro_priors(t, frame, targets)
             start = time.perf_counter()
-            try:
-                try:
-                    result = self._update(frame, prior)
-                except ValueError as exc:
-                    if prior is None:
-                        raise
-                    gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
-                    prior, gyro_box = None, None
-                    result = self._update(frame, None)
-            except Abandoned as exc:
-                return self._abandon(t, exc)
-            ms = (time.perf_counter() - start) * 1e3
+            results = [self._track(target, frame, t, *prior) for target, prior in zip(targets, priors)]
             with self._lock:
-                return self._record(frame, t, result, prior is not None, gyro_reason, gyro_box, ms)
+                if any(r.rejection is None for r in results):      # not all abandoned by the watchdog
+                    self.counters["frames_processed"] += 1
+                    self._recent.append((t, self._overall_state().value))
+                    self._recent_proc.append((t, (time.perf_counter() - start) * 1e3,
+                                              any(r.gyro_used for r in results)))
+            return results
 
-    def _update(self, frame, prior):
+    def _track(self, target: _Target, frame, t: int, prior, gyro_box, gyro_reason) -> FrameResult:
+        """One target's update into the frame at ``t`` (under the track lock)."""
+        start = time.perf_counter()
+        try:
+            try:
+                result = self._update(target, frame, prior)
+            except ValueError as exc:
+                if prior is None:
+                    raise
+                gyro_reason = f"gyro prior not usable ({exc}); tracked without it"
+                prior, gyro_box = None, None
+                result = self._update(target, frame, None)
+        except Abandoned as exc:
+            return self._abandon(target, t, exc)
+        ms = (time.perf_counter() - start) * 1e3
+        with self._lock:
+            return self._record(target, frame, t, result, prior is not None, gyro_reason, gyro_box, ms)
+
+    def _update(self, target: _Target, frame, prior):
         """The tracker's update, under the watchdog (:class:`Abandoned` when it overruns ``watchdog_ms``)."""
-        tracker = self._tracker
+        tracker = target.tracker
         return self._watchdog.run(lambda: tracker.update(frame, prior=prior), self._cfg.watchdog_ms / 1e3)
 
-    def _abandon(self, t: int, exc: Abandoned) -> FrameResult:
+    def _abandon(self, target: _Target, t: int, exc: Abandoned) -> FrameResult:
         """The result of the frame at ``t`` whose update was abandoned (or not started: ``exc.ran`` False); the
         tracker is rebuilt at its last good window (the init frame or the last frame not lost), the abandoned one is
         left to its thread."""
-        t_ref, box, ref_frame = self._ref
+        t_ref, box, ref_frame = target.ref
         if exc.ran:
             tracker = IemdTracker(self._cfg.tracker)
             tracker.init(ref_frame, box)
             reason = (f"tracker update abandoned after {self._cfg.watchdog_ms:g} ms (watchdog_ms); the tracker is "
                       f"rebuilt at its window of the frame stamped {t_ref} ns")
         else:
-            tracker = self._tracker
+            tracker = target.tracker
             reason = f"tracker update {exc} (watchdog_ms {self._cfg.watchdog_ms:g} ms): frame not tracked"
         with self._lock:
-            self._tracker = tracker
+            target.tracker = tracker
             self.counters["updates_abandoned"] += exc.ran
             self._last["watchdog_reason"] = self._last["frame_reason"] = reason
             self._recent.append((t, Rejection.ABANDONED.value))
-            return FrameResult(stamp_ns=t, state=self._state, rejection=Rejection.ABANDONED, reason=reason)
+            return FrameResult(stamp_ns=t, state=target.state, rejection=Rejection.ABANDONED, reason=reason,
+                               target_id=target.id)
 
     def _check_stamp(self, t: int) -> str:
         """"" if a frame stamped ``t`` can be processed, else why not (handles clock resets)."""
@@ -521,8 +714,8 @@ class TrackingPipeline:
             self._last["frame_reason"] = f"image clock jumped back by {_ms(back)}: treated as a clock reset"
             self._recent.clear()                       # the rates count from the reset
             self._recent_proc.clear()
-            if self._ref is not None:
-                self._ref = (t, self._ref[1], self._ref[2])     # no rotation can be integrated across it
+            for target in self._targets.values():
+                target.ref = (t, target.ref[1], target.ref[2])   # no rotation can be integrated across it
             newest = self._predictor.buffer.t_newest_ns
             if newest is not None and newest > self._predictor.imu_time(t) + self._cfg.clock_reset_ms * 1e6:
                 self._predictor = self._new_predictor()   # the IMU is still on the old clock
@@ -531,60 +724,68 @@ class TrackingPipeline:
             return f"image stamp {t} ns repeats the previous frame's"
         return f"image stamp went back by {_ms(back)} (previous frame {last} ns)"
 
-    def _gyro_prior(self, t: int, frame: np.ndarray):
-        """(prior or None, predicted box or None, reason) for the frame at ``t``."""
+    def _gyro_priors(self, t: int, frame: np.ndarray, targets: list[_Target]) -> list[tuple]:
+        """(prior or None, predicted box or None, reason) of each target for the frame at ``t``: the rotation is
+        integrated once per window stamp (once for all targets tracked on the previous frame)."""
         if not self._cfg.use_gyro:
-            return None, None, "gyro disabled (use_gyro is false)"
+            return [(None, None, "gyro disabled (use_gyro is false)")] * len(targets)
         camera = self._predictor.camera
         if camera is None:
-            return None, None, "no camera_info received: the gyro prior needs K"
+            return [(None, None, "no camera_info received: the gyro prior needs K")] * len(targets)
         try:
             camera.check_image(frame.shape[1], frame.shape[0])
             self._last["camera_misfit"] = ""
         except ValueError as exc:
             self._last["camera_misfit"] = str(exc)
-            return None, None, f"no gyro prior: {exc}"
-        t_ref, box, _ = self._ref
-        if t == t_ref:
-            return None, None, "frame has the window's own stamp"
-        try:
-            pred = self._predictor.predict(t_ref, t, box=box)
-        except ValueError as exc:      # e.g. a rotation that cannot be integrated: the frame goes on without it
-            return None, None, f"no gyro prior: {exc}"
-        if pred.prior is None:
-            return None, None, pred.reason
-        gyro_box = tuple(float(v) for v in pred.box) if pred.box is not None else None
-        return pred.prior, gyro_box, pred.reason
+            return [(None, None, f"no gyro prior: {exc}")] * len(targets)
+        rotations: dict[int, object] = {}
+        out = []
+        for target in targets:
+            t_ref, box, _ = target.ref
+            if t == t_ref:
+                out.append((None, None, "frame has the window's own stamp"))
+                continue
+            try:
+                if t_ref not in rotations:
+                    rotations[t_ref] = self._predictor.homography(t_ref, t)
+                pred = self._predictor.at_box(rotations[t_ref], box)
+            except ValueError as exc:  # e.g. a rotation that cannot be integrated: the frame goes on without it
+                out.append((None, None, f"no gyro prior: {exc}"))
+                continue
+            if pred.prior is None:
+                out.append((None, None, pred.reason))
+                continue
+            gyro_box = tuple(float(v) for v in pred.box) if pred.box is not None else None
+            out.append((pred.prior, gyro_box, pred.reason))
+        return out
 
-    def _record(self, frame, t, result, gyro_used, gyro_reason, gyro_box, ms) -> FrameResult:
+    def _record(self, target: _Target, frame, t, result, gyro_used, gyro_reason, gyro_box, ms) -> FrameResult:
         c = self.counters
-        c["frames_processed"] += 1
         c["gyro_used" if gyro_used else "gyro_unused"] += 1
         box = tuple(float(v) for v in result.box)
         if result.lost:
             c["frames_lost"] += 1
-            self._lost_run += 1
-            self._state = TrackState.LOST
+            target.lost_run += 1
+            target.state = TrackState.LOST
         else:
-            self._lost_run = 0
-            self._state = TrackState.TRACKING
+            target.lost_run = 0
+            target.state = TrackState.TRACKING
             c["frames_held"] += bool(result.held)
-            self._ref = (t, box, frame)
+            target.ref = (t, box, frame)
         emd = float(result.emd)
         score = math.exp(-emd / self._cfg.score_emd_scale) if not result.lost and math.isfinite(emd) else 0.0
         self._last["gyro_reason"] = gyro_reason
         self._last["frame_reason"] = result.reason
         self._last["watchdog_reason"] = ""
-        self._recent.append((t, self._state.value))
-        self._recent_proc.append((t, ms, gyro_used))
         predicted = None if result.predicted_box is None else tuple(float(v) for v in result.predicted_box)
         out = FrameResult(
-            stamp_ns=t, state=self._state, box=box, emd=emd, score=score, iterations=int(result.iterations),
+            stamp_ns=t, state=target.state, box=box, emd=emd, score=score, iterations=int(result.iterations),
             lost=bool(result.lost), held=bool(result.held), cause=result.cause, reason=result.reason,
             gyro_used=gyro_used, gyro_reason=gyro_reason, gyro_box=gyro_box, predicted_box=predicted,
             scale=float(result.scale), starts=int(result.starts), codings=int(result.codings),
-            solver_warnings=int(result.solver_warnings), processing_ms=ms, angle=float(result.angle))
-        self._last_result = out
+            solver_warnings=int(result.solver_warnings), processing_ms=ms, angle=float(result.angle),
+            target_id=target.id)
+        target.last_result = self._last_result = out
         return out
 
     # ------------------------------------------------------------------ diagnostics
@@ -610,8 +811,17 @@ class TrackingPipeline:
         with self._lock:
             d = dict(self.counters)
             d.update(self._last)
-            d["state"] = self._state.value
-            d["lost_run"] = self._lost_run
+            d["state"] = self._overall_state().value
+            d["lost_run"] = min((t.lost_run for t in self._targets.values()), default=0)
+            d["targets"] = ", ".join(f"{t.id or '(default)'}: {t.state.value}" for t in self._targets.values())
+            source = ExtrinsicSource.PARAMETER if self._tf_rotation is None else ExtrinsicSource.TF
+            imu_frame, camera_frame = self._frames
+            d["extrinsic_source"] = source.value
+            d["imu_frame"], d["camera_frame"] = imu_frame, camera_frame
+            d["R_cam_imu"] = np.round(self._predictor.calibration.R_cam_imu, 6).ravel().tolist()
+            d["frames_unrelated"] = bool(source is ExtrinsicSource.PARAMETER and imu_frame and camera_frame
+                                         and frame_name(imu_frame) != frame_name(camera_frame))
+            d["parameter_is_identity"] = bool(np.array_equal(self._cfg.gyro.rotation, np.eye(3)))
             camera = self._predictor.camera
             d["camera"] = "none" if camera is None else repr(camera)
             proc = list(self._recent_proc)

@@ -6,9 +6,10 @@ from dataclasses import asdict, dataclass
 
 from iemd_ros.tracking import Cause
 
-__all__ = ["TrackState", "Rejection", "FrameResult", "INIT_REASON"]
+__all__ = ["TrackState", "Rejection", "FrameResult", "INIT_REASON", "DEFAULT_TARGET", "ExtrinsicSource"]
 
 INIT_REASON = "target initialized on this frame"  # FrameResult.reason of the frame init() started on
+DEFAULT_TARGET = ""  # the target id of TrackingPipeline.init when none is given
 
 
 class TrackState(enum.Enum):
@@ -25,6 +26,13 @@ class Rejection(enum.Enum):
     STAMP = "rejected"      # its stamp repeats or goes back from the previous frame's
     MALFORMED = "malformed"  # the image message did not convert or decode
     ABANDONED = "abandoned"  # the tracker update overran watchdog_ms: the tracker was rebuilt
+
+
+class ExtrinsicSource(enum.Enum):
+    """Where the camera-IMU rotation of the gyro prior comes from."""
+
+    PARAMETER = "parameter gyro.R_cam_imu"  # no transform between the IMU's and the image's frames is known
+    TF = "tf"                               # the transform between the frames (TF, /tf_static)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,6 +89,8 @@ class FrameResult:
         The window's turn (radians), which the gyro priors change (mostly the camera's roll).
     is_init : bool
         The result of the frame :meth:`TrackingPipeline.init` started on.
+    target_id : str
+        The target the result is about (:data:`DEFAULT_TARGET` unless ``init`` named one).
     """
 
     stamp_ns: int
@@ -105,6 +115,7 @@ class FrameResult:
     processing_ms: float = 0.0
     angle: float = 0.0
     is_init: bool = False  # the result of the frame TrackingPipeline.init started on
+    target_id: str = DEFAULT_TARGET
 
     @property
     def tracking(self) -> bool:

@@ -7,13 +7,23 @@ Topics (relative names, remap with ``-r image:=/camera/image_raw`` ...):
   plugin publishes them; ``image`` remapped to a compressed stream itself is taken as it is), ``imu``
   (sensor_msgs/Imu, angular velocity in the IMU frame), ``camera_info`` (sensor_msgs/CameraInfo: K, plumb_bob D);
   sensor-data QoS (best effort) unless ``reliable_qos`` is true.
-* publishes ``detections`` (vision_msgs/Detection2DArray, the image's header, one Detection2D while tracking,
-  empty when lost or not initialized), ``/diagnostics`` (diagnostic_msgs/DiagnosticArray) and ``~/debug_image``
-  (annotated bgr8, drawn only while somebody subscribes).
-* start/restart: parameter ``initial_box`` [x, y, w, h] (applied to the next frame), topic ``~/init``
-  (vision_msgs/Detection2D; its header stamp picks the frame from a ring buffer of recent frames, a zero stamp
-  means the newest frame), service ``~/reset`` (std_srvs/Trigger: forget the target; restart from ``initial_box``
-  if it is set).
+* publishes ``detections`` (vision_msgs/Detection2DArray, the image's header, one Detection2D per tracked target
+  with the target's id, empty when none is tracked), ``bearings`` (vision_msgs/Detection3DArray in the image's
+  optical frame: the unit ray to each target and its angular size, :func:`~iemd_ros.messages.outputs.bearing_array`),
+  ``~/annotations`` (foxglove_msgs/ImageAnnotations: the boxes Foxglove's Image panel draws over the image),
+  ``/diagnostics`` (diagnostic_msgs/DiagnosticArray), ``~/debug_image`` (annotated bgr8) and
+  ``~/debug_image/compressed`` (the same as JPEG), both drawn only while somebody subscribes.
+* targets: parameter ``initial_box`` [x, y, w, h] (the target ``detection_id``, applied to the next frame), topic
+  ``~/init`` (vision_msgs/Detection2D: adds the target of its ``id``, or restarts the one with that id; an empty id
+  is ``detection_id``; its header stamp picks the frame from a ring buffer of recent frames, a zero stamp means the
+  newest frame), topic ``~/drop`` (std_msgs/String: forget the target of that id), service ``~/reset``
+  (std_srvs/Trigger: forget every target; restart from ``initial_box`` if it is set).
+* extrinsics: the camera-IMU rotation is looked up in TF between the IMU message's frame and the image's frame
+  (:class:`~iemd_ros.ros.extrinsics.TfExtrinsics`), ``gyro.R_cam_imu`` when no transform is known.
+
+:class:`TrackerNode` starts at once; :class:`LifecycleTrackerNode` (``ros2 run iemd_ros tracker_lifecycle``) is the
+managed variant: configure creates the pipeline, subscriptions and publishers, activate starts tracking and
+publishing, deactivate stops both (the target and the IMU buffer are kept), cleanup destroys them.
 
 Parameters: :mod:`iemd_ros.ros.parameters` (docs/parameters.md).
 
@@ -35,27 +45,33 @@ import numpy as np
 import rclpy
 from diagnostic_msgs.msg import DiagnosticArray
 from rcl_interfaces.msg import SetParametersResult
+from foxglove_msgs.msg import ImageAnnotations
 from rclpy.exceptions import ParameterException
+from rclpy.lifecycle import LifecycleNode, TransitionCallbackReturn
 from rclpy.node import Node
 from rclpy.parameter import Parameter as RclpyParameter
 from rclpy.qos import QoSProfile, QoSReliabilityPolicy, qos_profile_sensor_data
 from sensor_msgs.msg import CameraInfo, CompressedImage, Image, Imu
+from std_msgs.msg import String
 from std_srvs.srv import Trigger
-from vision_msgs.msg import Detection2D, Detection2DArray
+from vision_msgs.msg import Detection2D, Detection2DArray, Detection3DArray
 
 from iemd_ros.common.boxes import check_box
 from iemd_ros.common.cli import one_line
-from iemd_ros.messages.conversions import (bbox_to_box, bbox_values, camera_model_from_msg, compressed_topic,
-                                           fill_image_msg, image_from_msg, imu_sample, is_compressed_topic, raw_twin,
-                                           stamp_ns)
-from iemd_ros.messages.outputs import detection_array, diagnostic_array, header
+from iemd_ros.messages.conversions import (array_to_compressed_fields, bbox_to_box, bbox_values,
+                                           camera_model_from_msg, compressed_topic, fill_image_msg, image_from_msg,
+                                           imu_sample, is_compressed_topic, raw_twin, stamp_ns)
+from iemd_ros.messages.outputs import bearing_array, detection_array, diagnostic_array, header, image_annotations
 from iemd_ros.pipeline import FrameResult, ImuWait, Level, Part, PipelineConfig, TrackingPipeline, TrackState
-from iemd_ros.pipeline.drawing import draw_result
+from iemd_ros.pipeline.drawing import box_colour, draw_results
+from iemd_ros.pipeline.pipeline import kernel_cache_dir, kernels_cached
+from iemd_ros.pipeline.topic_status import TopicStatus
+from iemd_ros.ros.extrinsics import TfExtrinsics
 from iemd_ros.ros.messages import RCLPY_MESSAGES
 from iemd_ros.ros.parameters import NODE_NAME, ImageTransport, NodeConfig, descriptor, parameters
-from iemd_ros.ros.spin import spin_until_shutdown, stopped_by_shutdown
+from iemd_ros.ros.spin import quiet_interrupts, spin_until_shutdown, stopped_by_shutdown
 
-__all__ = ["TrackerNode", "main", "NODE_NAME"]
+__all__ = ["TrackerNode", "LifecycleTrackerNode", "main", "main_lifecycle", "NODE_NAME"]
 
 
 class Note(enum.Enum):
@@ -66,26 +82,49 @@ class Note(enum.Enum):
     # an INIT note is a WARN while tracking (the previous target stays) until the next init or ~/reset
 
 
-class TrackerNode(Node):
-    """The iEMD tracker node (see the module docstring for topics, parameters and threading)."""
+class _Op(enum.Enum):
+    """Requests for the worker thread."""
 
-    def __init__(self, node_name: str = NODE_NAME, **kwargs):
-        super().__init__(node_name, **kwargs)
+    CONFIG = "config"
+    RESET = "reset"
+    INIT = "init"
+    DROP = "drop"
+
+
+class _Tracker:
+    """What the plain and the managed node share; mixed into a :class:`rclpy.node.Node` (see the module docstring).
+
+    :meth:`_declare` declares the parameters (at construction), :meth:`_start` builds the pipeline, subscriptions,
+    publishers and the worker, :meth:`_shut` takes them down; :attr:`_active` gates tracking and publishing.
+    """
+
+    def _declare(self) -> None:
         self._declared = parameters()
         for p in self._declared:
             self.declare_parameter(p.name, p.default, descriptor(p))
+        self._started = False
+        self._active = False
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+
+    def _start(self, make_publisher) -> None:
+        """Build everything from the current parameters; ``make_publisher`` creates the output publishers (the
+        managed node's are lifecycle publishers).  ValueError for invalid parameters."""
         values = self._values({})
         cfg = PipelineConfig.from_parameters(values)  # ValueError: invalid parameter file / overrides
         node = NodeConfig.from_parameters(values)
         self._node_cfg = node
         self._initial_box = self._check_initial_box(node.initial_box)
+        if not kernels_cached():
+            self.get_logger().warning(
+                f"compiling the tracker's numba kernels into {kernel_cache_dir()} (10-30 s, once per install: "
+                f"`iemd-compile` at install time avoids this wait)")
         self.pipeline = TrackingPipeline(cfg)
         self._wait = ImuWait(self.pipeline)
 
         self._cond = threading.Condition()
         self._latest: Image | CompressedImage | None = None  # single-slot buffer of the newest frame
         self._ring: deque = deque(maxlen=node.frame_buffer_size)  # recent frames for ~/init
-        self._ops: list = []                         # requests for the worker (config, reset, init)
+        self._ops: list = []                         # requests for the worker (_Op, ...)
         self._pending_box = self._initial_box        # initial_box to apply to the next frame
         self._latest_received = None
         self._awaiting_imu: int | None = None        # stamp of the frame the worker holds for IMU coverage
@@ -93,32 +132,65 @@ class TrackerNode(Node):
         self._busy: tuple[float, int] | None = None  # (monotonic start, stamp) of the frame the worker is on
         self._note: tuple[Note, str] | None = None   # the latest init problem / internal error
         self._last_image_wall = self._last_imu_wall = None
+        self._imu_frame = ""
         self._latency_ms: deque = deque(maxlen=30)
-        self._started = time.monotonic()
+        self._start_wall = time.monotonic()
+        self._output_status = TopicStatus(node.min_rate_hz, node.max_rate_hz, node.rate_tolerance,
+                                          node.rate_window, node.stamp_age_min_s, node.stamp_age_max_s,
+                                          self._start_wall)
         if node.reliable_qos:
             sensor_qos = QoSProfile(depth=5, reliability=QoSReliabilityPolicy.RELIABLE)
             imu_qos = QoSProfile(depth=200, reliability=QoSReliabilityPolicy.RELIABLE)
         else:
             sensor_qos = qos_profile_sensor_data
             imu_qos = QoSProfile(depth=200, reliability=QoSReliabilityPolicy.BEST_EFFORT)
-        self._det_pub = self.create_publisher(Detection2DArray, "detections", 10)
+        self._det_pub = make_publisher(Detection2DArray, "detections", 10)
+        self._bearing_pub = make_publisher(Detection3DArray, "bearings", 10)
+        self._annotation_pub = make_publisher(ImageAnnotations, "~/annotations", 10)
+        self._debug_pub = make_publisher(Image, "~/debug_image", 1)
+        self._debug_jpeg_pub = make_publisher(CompressedImage, "~/debug_image/compressed", 1)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", 10)
-        self._debug_pub = self.create_publisher(Image, "~/debug_image", 1)
         image_sub = self._subscribe_image(node.image_transport, sensor_qos)
         self._image_topic = image_sub.topic_name  # after remapping
-        self.create_subscription(Imu, "imu", self._on_imu, imu_qos)
-        self.create_subscription(CameraInfo, "camera_info", self._on_camera_info, sensor_qos)
-        self.create_subscription(Detection2D, "~/init", self._on_init, 10)
-        self.create_service(Trigger, "~/reset", self._on_reset)
-        self.create_timer(node.diagnostics_period_s, self._publish_diagnostics)
-        self.add_on_set_parameters_callback(self._on_set_parameters)
+        self._entities = [
+            image_sub, self._diag_pub,
+            self.create_subscription(Imu, "imu", self._on_imu, imu_qos),
+            self.create_subscription(CameraInfo, "camera_info", self._on_camera_info, sensor_qos),
+            self.create_subscription(Detection2D, "~/init", self._on_init, 10),
+            self.create_subscription(String, "~/drop", self._on_drop, 10),
+            self.create_service(Trigger, "~/reset", self._on_reset),
+            self.create_timer(node.diagnostics_period_s, self._publish_diagnostics)]
+        self._outputs = [self._det_pub, self._bearing_pub, self._annotation_pub, self._debug_pub,
+                         self._debug_jpeg_pub]
+        self._extrinsics = TfExtrinsics(self, self._warn)
 
         self._worker = threading.Thread(target=self._work, name="iemd_tracker_worker", daemon=True)
         self._worker.start()
+        self._started = True
         self.get_logger().info(
             f"tracking '{self._image_topic}' -> '{self.resolve_topic_name('detections')}' "
             f"(gyro {'on' if cfg.use_gyro else 'off'}, {'reliable' if node.reliable_qos else 'sensor-data'} "
-            f"QoS); {'initial box ' + str(self._initial_box) if self._initial_box else 'waiting for ~/init'}")
+            f"QoS, camera-IMU rotation from {self._extrinsics.backend} or gyro.R_cam_imu); "
+            f"{'initial box ' + str(self._initial_box) if self._initial_box else 'waiting for ~/init'}")
+
+    def _shut(self, destroy_publisher) -> None:
+        """Stop the worker and destroy what :meth:`_start` built (``destroy_publisher`` for the outputs)."""
+        if not self._started:
+            return
+        self._active = False
+        with self._cond:
+            self._stop = True
+            self._cond.notify_all()
+        if self._worker.is_alive() and threading.current_thread() is not self._worker:
+            self._worker.join(timeout=5.0)
+        self._extrinsics.close()
+        for pub in self._outputs:
+            destroy_publisher(pub)
+        for entity in self._entities:
+            kind = type(entity).__name__
+            {"Subscription": self.destroy_subscription, "Publisher": self.destroy_publisher,
+             "Service": self.destroy_service, "Timer": self.destroy_timer}[kind](entity)
+        self._started = False
 
     # ------------------------------------------------------------------ parameters
     def _subscribe_image(self, transport: ImageTransport, qos):
@@ -163,11 +235,15 @@ class TrackerNode(Node):
             box = self._check_initial_box(node.initial_box) if "initial_box" in changes else None
         except (ValueError, TypeError) as exc:
             return SetParametersResult(successful=False, reason=str(exc))
+        if not self._started:                       # the managed node before configure: taken then
+            return SetParametersResult(successful=True)
         node_only = {p.name for p in self._declared if p.node_only}
         with self._cond:
             self._node_cfg = node
+            self._output_status.configure(node.min_rate_hz, node.max_rate_hz, node.rate_tolerance, node.rate_window,
+                                          node.stamp_age_min_s, node.stamp_age_max_s)
             if any(name not in node_only for name in changes):
-                self._ops.append(("config", cfg))
+                self._ops.append((_Op.CONFIG, cfg))
             if "initial_box" in changes:
                 self._initial_box = self._pending_box = box
             self._cond.notify_all()
@@ -175,6 +251,8 @@ class TrackerNode(Node):
 
     # ------------------------------------------------------------------ callbacks (fast)
     def _on_image(self, msg: Image | CompressedImage) -> None:
+        if not self._active:
+            return
         now = time.monotonic()
         self._last_image_wall = now
         with self._cond:
@@ -187,6 +265,7 @@ class TrackerNode(Node):
 
     def _on_imu(self, msg: Imu) -> None:
         self._last_imu_wall = time.monotonic()
+        self._imu_frame = msg.header.frame_id
         if not self.pipeline.add_imu_message(*imu_sample(msg)):
             self._warn(self.pipeline.last_reasons()["imu_reason"])
         # Wake the worker only when this sample lets the frame it holds go.  No race: the sample is stored before
@@ -212,19 +291,26 @@ class TrackerNode(Node):
         except ValueError as exc:
             self._set_note(Note.INIT, f"~/init rejected: {exc}")
             return
+        target = msg.id or self._node_cfg.detection_id
         with self._cond:
-            self._ops.append(("init", box, stamp_ns(msg.header)))
-            self._pending_box = None
+            self._ops.append((_Op.INIT, box, stamp_ns(msg.header), target))
+            if target == self._node_cfg.detection_id:
+                self._pending_box = None
+            self._cond.notify_all()
+
+    def _on_drop(self, msg: String) -> None:
+        with self._cond:
+            self._ops.append((_Op.DROP, msg.data))
             self._cond.notify_all()
 
     def _on_reset(self, request, response):
         with self._cond:
-            self._ops.append(("reset",))
+            self._ops.append((_Op.RESET,))
             self._pending_box = self._initial_box
             self._cond.notify_all()
         response.success = True
-        response.message = ("target cleared; restarting from initial_box on the next frame"
-                            if self._initial_box is not None else "target cleared; waiting for ~/init")
+        response.message = ("targets cleared; restarting from initial_box on the next frame"
+                            if self._initial_box is not None else "targets cleared; waiting for ~/init")
         return response
 
     def _warn(self, text: str) -> None:
@@ -261,7 +347,7 @@ class TrackerNode(Node):
             except Exception as exc:
                 if self._internal_error(exc):
                     return
-                self._publish(msg, None, received)     # the frame is answered all the same: no detection
+                self._publish(msg, [], received)     # the frame is answered all the same: no detection
             finally:
                 self._busy = None
 
@@ -274,16 +360,21 @@ class TrackerNode(Node):
 
     def _apply(self, op) -> None:
         kind = op[0]
-        if kind == "config":
+        if kind is _Op.CONFIG:
             what = self.pipeline.configure(op[1])
             self.get_logger().info(f"parameters applied: {what}")
-        elif kind == "reset":
+        elif kind is _Op.RESET:
             self.pipeline.reset()
             self._note = None
-        elif kind == "init":
-            self._init_from_ring(op[1], op[2])
+        elif kind is _Op.INIT:
+            self._init_from_ring(*op[1:])
+        elif kind is _Op.DROP:
+            if self.pipeline.drop(op[1]):
+                self.get_logger().info(f"target '{op[1]}' dropped")
+            else:
+                self._warn(f"~/drop: no target '{op[1]}' (targets: {', '.join(self.pipeline.targets) or 'none'})")
 
-    def _init_from_ring(self, box, stamp: int) -> None:
+    def _init_from_ring(self, box, stamp: int, target: str) -> None:
         with self._cond:
             frames = list(self._ring)
         if not frames:
@@ -297,12 +388,13 @@ class TrackerNode(Node):
                                       f"stamp {stamp} ns (buffer spans {stamps.min()}..{stamps.max()} ns)")
             return
         try:
-            self.pipeline.init(image_from_msg(frames[i]), box, int(stamps[i]))
+            self.pipeline.init(image_from_msg(frames[i]), box, int(stamps[i]), target)
         except ValueError as exc:
             self._set_note(Note.INIT, f"~/init failed: {exc}")
             return
         self._note = None
-        self.get_logger().info(f"target initialized from ~/init at {box} on the frame stamped {int(stamps[i])} ns")
+        self.get_logger().info(f"target '{target}' initialized from ~/init at {box} on the frame stamped "
+                               f"{int(stamps[i])} ns")
 
     def _handle_frame(self, msg: Image | CompressedImage, received) -> None:
         stamp = stamp_ns(msg.header)
@@ -310,26 +402,58 @@ class TrackerNode(Node):
             frame = image_from_msg(msg)
         except ValueError as exc:
             self._warn(f"image rejected: {exc}")
-            self._publish(msg, self.pipeline.note_bad_image(str(exc), stamp), received)
+            self._publish(msg, [self.pipeline.note_bad_image(str(exc), stamp)], received)
             return
+        self._update_extrinsic(msg.header.frame_id)
         with self._cond:                   # initial_box (startup, parameter change, ~/reset): this frame
             pending_box, self._pending_box = self._pending_box, None
         if pending_box is not None:
-            try:
-                result = self.pipeline.init(frame, pending_box, stamp)
-            except ValueError as exc:
-                self._set_note(Note.INIT, f"initial_box not usable: {exc}")
-                self._publish(msg, None, received)
+            results = self._init_on_frame(frame, pending_box, stamp)
+            if results is None:
+                self._publish(msg, [], received)
                 return
-            self._note = None
-            self.get_logger().info(f"target initialized at {pending_box}")
         else:
             self._wait_for_gyro(stamp)
-            result = self.pipeline.process(frame, stamp)
+            results = self.pipeline.process_all(frame, stamp)
         if self._note is not None and self._note[0] is Note.INTERNAL_ERROR:
             self._note = None                          # a good frame clears it
-        self._publish(msg, result, received)
-        self._publish_debug(msg, frame, result)
+        self._publish(msg, results, received)
+        self._publish_debug(msg, frame, results)
+
+    def _init_on_frame(self, frame, box, stamp: int) -> list[FrameResult] | None:
+        """initial_box on this frame (the target ``detection_id``), after tracking the other targets into it; None
+        when the box cannot be used."""
+        target = self._node_cfg.detection_id
+        others = [t for t in self.pipeline.targets if t != target]
+        results = []
+        if others:
+            self._wait_for_gyro(stamp)
+            results = [r for r in self.pipeline.process_all(frame, stamp) if r.target_id != target]
+        try:
+            results.append(self.pipeline.init(frame, box, stamp, target))
+        except ValueError as exc:
+            self._set_note(Note.INIT, f"initial_box not usable: {exc}")
+            return None
+        self._note = None
+        self.get_logger().info(f"target '{target}' initialized at {box}")
+        return results
+
+    def _update_extrinsic(self, camera_frame: str) -> None:
+        """The camera-IMU rotation from TF between the latest IMU message's frame and this image's frame (the
+        parameter when the frames are one, unnamed, or no transform is known)."""
+        imu_frame = self._imu_frame
+        R = None
+        if imu_frame and camera_frame and imu_frame.lstrip("/") != camera_frame.lstrip("/"):
+            R = self._extrinsics.rotation(camera_frame, imu_frame)
+        try:
+            changed = self.pipeline.set_extrinsic(R, imu_frame, camera_frame)
+        except ValueError as exc:
+            self._warn(f"transform {imu_frame} -> {camera_frame} not used: {exc}")
+            return
+        if changed:
+            self.get_logger().info(
+                f"camera-IMU rotation: {'from TF' if R is not None else 'gyro.R_cam_imu (no transform known)'} "
+                f"({imu_frame} -> {camera_frame}): {np.round(self.pipeline.extrinsic[1], 6).tolist()}")
 
     def _wait_for_gyro(self, stamp: int) -> None:
         """Hold the frame stamped ``stamp`` until the gyro covers it or it has waited its longest (ImuWait)."""
@@ -344,27 +468,43 @@ class TrackerNode(Node):
             self._awaiting_imu = None
 
     # ------------------------------------------------------------------ output
-    def _publish(self, img: Image | CompressedImage, result: FrameResult | None, received) -> None:
-        """The image's Detection2DArray: one detection while ``result`` is tracking, else empty."""
-        out = detection_array(RCLPY_MESSAGES, img.header, result, self._node_cfg.class_id,
-                              self._node_cfg.detection_id)
-        if self._stop or not self.context.ok():
+    def _publish(self, img: Image | CompressedImage, results: list, received) -> None:
+        """The image's Detection2DArray (one detection per tracked target), its bearings and annotations."""
+        cfg = self._node_cfg
+        results = [r for r in results if r is not None]
+        out = detection_array(RCLPY_MESSAGES, img.header, results, cfg.class_id, cfg.detection_id)
+        bearings = bearing_array(RCLPY_MESSAGES, img.header, results, self.pipeline.camera, cfg.class_id,
+                                 cfg.detection_id)
+        annotations = image_annotations(RCLPY_MESSAGES, stamp_ns(img.header), results, cfg.detection_id, box_colour)
+        if self._stop or not self._active or not self.context.ok():
             return
         self._det_pub.publish(out)
+        self._bearing_pub.publish(bearings)
+        self._annotation_pub.publish(annotations)
+        self._output_status.tick(time.monotonic(), (self.get_clock().now().nanoseconds - stamp_ns(img.header)) / 1e9,
+                                 stamp_ns(img.header) == 0)
         if received is not None:
             self._latency_ms.append((time.monotonic() - received) * 1e3)
 
-    def _publish_debug(self, img: Image | CompressedImage, frame: np.ndarray, result: FrameResult) -> None:
-        if self._debug_pub.get_subscription_count() == 0 or self._stop:
+    def _publish_debug(self, img: Image | CompressedImage, frame: np.ndarray, results: list) -> None:
+        raw, jpeg = (pub.get_subscription_count() > 0 for pub in (self._debug_pub, self._debug_jpeg_pub))
+        if not (raw or jpeg) or self._stop:
             return
-        out = fill_image_msg(Image(), draw_result(frame, result))
-        out.header = img.header
-        if self.context.ok():
-            self._debug_pub.publish(out)
+        drawn = draw_results(frame, results)
+        if raw:
+            out = fill_image_msg(Image(), drawn)
+            out.header = img.header
+        if jpeg:
+            compressed = CompressedImage(header=img.header, **array_to_compressed_fields(drawn, "jpeg"))
+        if self.context.ok() and self._active:
+            if raw:
+                self._debug_pub.publish(out)
+            if jpeg:
+                self._debug_jpeg_pub.publish(compressed)
 
     def diagnostic_statuses(self) -> list[tuple[str, Level, str, dict]]:
-        """The pipeline's statuses with the node's wall-clock liveness checks and notes: (name, level, message,
-        values) tuples."""
+        """The pipeline's statuses with the node's wall-clock liveness checks and notes, and the detections' rate
+        and stamp-age status: (name, level, message, values) tuples."""
         now = time.monotonic()
         timeout = self._node_cfg.input_timeout_s
         stuck = self._stuck(now)
@@ -372,7 +512,7 @@ class TrackerNode(Node):
         for s in self.pipeline.statuses():
             level, message, values = s.level, s.message, dict(s.values)
             if s.part is Part.IMAGE:
-                since = now - (self._last_image_wall or self._started)
+                since = now - (self._last_image_wall or self._start_wall)
                 values["latency_ms_mean"] = f"{np.mean(self._latency_ms):.1f}" if self._latency_ms else "nan"
                 values["topic"] = self._image_topic
                 if since > timeout and level < Level.ERROR:
@@ -381,7 +521,8 @@ class TrackerNode(Node):
                     message = note if level == Level.OK or not self._last_image_wall else f"{message}; {note}"
                     level = Level.WARN
             elif s.part is Part.IMU and self.pipeline.config.use_gyro and level < Level.ERROR:
-                since = now - (self._last_imu_wall or self._started)
+                since = now - (self._last_imu_wall or self._start_wall)
+                values["tf_backend"] = self._extrinsics.backend
                 if since > timeout:
                     topic = self.resolve_topic_name("imu")
                     note = (f"no IMU message on {topic} for {since:.1f} s" if self._last_imu_wall else
@@ -400,6 +541,10 @@ class TrackerNode(Node):
                 else:                                  # an ~/init that could not be used: the old target stays
                     level, message = max(level, Level.WARN), f"{message}; {text}"
             out.append((s.name(self.get_name()), level, message, values))
+        if self._active:
+            level, message, values = self._output_status.status(now)
+            values["topic"] = self.resolve_topic_name("detections")
+            out.append((f"{self.get_name()}: {Part.OUTPUT.value}", level, message, values))
         return out
 
     def _stuck(self, now: float) -> str:
@@ -419,20 +564,76 @@ class TrackerNode(Node):
         self._diag_pub.publish(diagnostic_array(RCLPY_MESSAGES, hdr, self.diagnostic_statuses(),
                                                 self.get_fully_qualified_name()))
 
+
+class TrackerNode(_Tracker, Node):
+    """The iEMD tracker node, tracking from its start (see the module docstring for topics, parameters, threading).
+
+    Raises
+    ------
+    ValueError
+        For invalid parameters.
+    """
+
+    def __init__(self, node_name: str = NODE_NAME, **kwargs):
+        super().__init__(node_name, **kwargs)
+        self._declare()
+        self._start(self.create_publisher)
+        self._active = True
+
     def destroy_node(self):
-        with self._cond:
-            self._stop = True
-            self._cond.notify_all()
-        if self._worker.is_alive() and threading.current_thread() is not self._worker:
-            self._worker.join(timeout=5.0)
+        self._shut(self.destroy_publisher)
         return super().destroy_node()
 
 
-def main(args=None) -> int:
-    """Entry point of ``ros2 run iemd_ros tracker`` (and ``iemd-tracker``)."""
+class LifecycleTrackerNode(_Tracker, LifecycleNode):
+    """The managed iEMD tracker node (``ros2 run iemd_ros tracker_lifecycle``; REP 2000's lifecycle).
+
+    unconfigured -> configure (parameters checked, pipeline, subscriptions, publishers and the worker built; FAILURE
+    with the reason for invalid parameters) -> inactive -> activate (images are tracked and the outputs published)
+    -> active; deactivate stops tracking and publishing, keeping the targets and the IMU buffer; cleanup destroys
+    what configure built; shutdown from any state.  /diagnostics is published from configure on.
+    """
+
+    def __init__(self, node_name: str = NODE_NAME, **kwargs):
+        super().__init__(node_name, **kwargs)
+        self._declare()
+
+    def on_configure(self, state) -> TransitionCallbackReturn:
+        try:
+            self._start(self.create_lifecycle_publisher)
+        except (ValueError, ParameterException) as exc:
+            self.get_logger().error(f"configure failed: invalid parameters: {one_line(exc)}")
+            return TransitionCallbackReturn.FAILURE
+        return super().on_configure(state)
+
+    def on_activate(self, state) -> TransitionCallbackReturn:
+        ret = super().on_activate(state)
+        self._active = ret == TransitionCallbackReturn.SUCCESS
+        return ret
+
+    def on_deactivate(self, state) -> TransitionCallbackReturn:
+        self._active = False
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state) -> TransitionCallbackReturn:
+        self._shut(self.destroy_lifecycle_publisher)
+        return super().on_cleanup(state)
+
+    def on_shutdown(self, state) -> TransitionCallbackReturn:
+        self._shut(self.destroy_lifecycle_publisher)
+        return super().on_shutdown(state)
+
+    def destroy_node(self):
+        self._shut(self.destroy_lifecycle_publisher)
+        return super().destroy_node()
+
+
+def _run(make_node, args) -> int:
+    """Start ``make_node()`` and spin it until shutdown: 0, or 2 with one line for invalid parameters."""
+    quiet_interrupts()
     rclpy.init(args=args if args is not None else sys.argv)
     try:
-        node = TrackerNode()
+        node = make_node()
     except (ValueError, ParameterException) as exc:  # invalid parameters: one readable line, exit 2
         print(f"{NODE_NAME}: invalid parameters: {one_line(exc)}", file=sys.stderr)
         rclpy.try_shutdown()
@@ -447,6 +648,17 @@ def main(args=None) -> int:
     except KeyboardInterrupt:  # a second Ctrl-C before the clean-up could ignore it: stopping all the same
         pass
     return 0
+
+
+def main(args=None) -> int:
+    """Entry point of ``ros2 run iemd_ros tracker`` (and ``iemd-tracker``)."""
+    return _run(TrackerNode, args)
+
+
+def main_lifecycle(args=None) -> int:
+    """Entry point of ``ros2 run iemd_ros tracker_lifecycle`` (and ``iemd-tracker-lifecycle``): the managed node,
+    unconfigured until a lifecycle manager (or ``ros2 lifecycle set``) configures and activates it."""
+    return _run(LifecycleTrackerNode, args)
 
 
 if __name__ == "__main__":

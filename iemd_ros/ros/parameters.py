@@ -53,8 +53,19 @@ class NodeConfig:
     diagnostics_period_s: float = param(1.0, "period of /diagnostics", unit="s", range=(0.01, 60.0), read_only=True)
     input_timeout_s: float = param(2.0, "warn when no image or IMU message arrived for this long", unit="s",
                                    range=(0.01, 3600.0))
-    class_id: str = param(CLASS_ID, "class_id of the published hypothesis")
-    detection_id: str = param(DETECTION_ID, "id of the published Detection2D")
+    class_id: str = param(CLASS_ID, "class_id of the published hypotheses")
+    detection_id: str = param(DETECTION_ID, "id of the target of initial_box and of an ~/init without an id")
+    min_rate_hz: float = param(1.0, "detections slower than this (less the tolerance) are a WARN in /diagnostics "
+                               "(diagnostic_updater's FrequencyStatus)", unit="Hz", range=(0.0, 10_000.0))
+    max_rate_hz: float = param(0.0, "detections faster than this (plus the tolerance) are a WARN; 0 for no upper "
+                               "bound", unit="Hz", range=(0.0, 10_000.0))
+    rate_tolerance: float = param(0.1, "relative tolerance of min_rate_hz and max_rate_hz", range=(0.0, 1.0))
+    rate_window: int = param(5, "diagnostics periods the detections' rate is measured over", range=(1, 1000))
+    stamp_age_min_s: float = param(-1.0, "a detection stamped more than this in the future at publication is an "
+                                   "ERROR (diagnostic_updater's TimeStampStatus; negative: in the future)", unit="s",
+                                   range=(-3600.0, 3600.0))
+    stamp_age_max_s: float = param(5.0, "a detection whose stamp is older than this at publication is an ERROR",
+                                   unit="s", range=(-3600.0, 1e9))
 
     def __post_init__(self):
         coerce(self)

@@ -3,6 +3,11 @@
 SIGINT and SIGTERM make rclpy shut the context down from its signal handler, at any moment: between two waits
 ``rclpy.spin`` ends with ExternalShutdownException, but in the middle of one it can raise RCLError ("failed to
 initialize wait set: the given context is not valid"), and so can the node's own calls.  Both are a clean stop.
+
+rclpy's handler then calls the handler it found, Python's, which raises KeyboardInterrupt wherever the main thread
+happens to be: under ``ros2 launch`` the node gets the terminal's SIGINT and launch's forwarded one, and the second
+could land in the middle of the clean-up.  :func:`quiet_interrupts` (before ``rclpy.init``) makes Python's SIGINT
+handler a no-op, so SIGINT only ever shuts the context down.
 """
 from __future__ import annotations
 
@@ -13,7 +18,21 @@ import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 
-__all__ = ["spin_until_shutdown", "stopped_by_shutdown"]
+__all__ = ["spin_until_shutdown", "stopped_by_shutdown", "quiet_interrupts"]
+
+
+def quiet_interrupts() -> None:
+    """Make SIGINT raise no KeyboardInterrupt (call it from the main thread before ``rclpy.init``).
+
+    rclpy's signal handler, installed by ``rclpy.init`` on top of this one, still shuts the context down on every
+    SIGINT, which ends spinning cleanly; this handler, which it calls next, does nothing.
+    """
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, _no_interrupt)
+
+
+def _no_interrupt(signum, frame) -> None:
+    """SIGINT after rclpy's handler has shut the context down: nothing more to do."""
 
 
 def stopped_by_shutdown(exc: BaseException, context=None) -> bool:

@@ -1,210 +1,239 @@
-"""What the scale and the translation filter share: DSST's correlation filter and its features.
+"""What the translation filter (STRCF) and the scale filter (fDSST) share: region sampling, windows, labels, the
+response's confidence and its sub-cell peak, and the fused spectral kernels.
 
-* :class:`FilterModel`: a multi-channel correlation filter in the Fourier domain (DSST eq. 5) learnt as a
-  running average;
-* :func:`orientation_histograms`: the features, gradient-orientation histograms on CELL x CELL cells;
-* :func:`parabola_peak`: a response's peak refined between samples;
-* :func:`model_size` and :func:`hann`: the resampled window and the taper of the features.
+Coordinates: a centre is ``(cx, cy)`` in pixels with pixel centres at integers (``x + (w - 1) / 2`` of a 0-based box
+``(x, y, w, h)``, :mod:`iemd_ros.common.boxes`); a size is ``(w, h)``.
 """
 from __future__ import annotations
 
+import cv2
 import numba
 import numpy as np
 
-N_ORIENTATIONS = 9  # unsigned gradient orientation bins of the features
-CELL = 4  # feature cell size, model pixels
-FLOOR = 0.05  # added to a cell histogram's norm (gradient magnitudes in grey levels per pixel, [0, 1] scale)
+from iemd_ros.tracking.appearance import window_axes
+
+__all__ = ["sample_region", "hann_inner", "gaussian_label", "apce", "peak_to_sidelobe", "SubCellPeak"]
 
 
-class FilterModel:
-    """Multi-channel correlation filter in the Fourier domain (DSST eq. 5).
+# ---------------------------------------------------------------------------------------------- sampling
+def sample_region(img: np.ndarray, centre, region_wh, out_wh, angle: float = 0.0) -> np.ndarray:
+    """The region of ``region_wh`` (w, h) pixels centred on ``centre`` and turned by ``angle``, resampled to
+    ``out_wh`` pixels; parts outside the image replicate its border.
 
-    Shared by the scale and the translation filter: numerator G conj(F_l) and denominator sum_l |F_l|^2 of the samples
-    learnt, as running averages at ``learning_rate`` (the first sample replaces them).
-
-    Parameters
-    ----------
-    learning_rate : float
-        Rate of the running averages, in (0, 1].
-    regularization : float
-        Added to the denominator when the filter responds.
-    channel_axis : int
-        Axis of the feature channels in the spectra.
-
-    Raises
-    ------
-    ValueError
-        For a ``learning_rate`` outside (0, 1].
-    """
-
-    def __init__(self, learning_rate: float, regularization: float, channel_axis: int):
-        if not 0.0 < learning_rate <= 1.0:
-            raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
-        self.learning_rate = learning_rate
-        self.regularization = regularization
-        self.channel_axis = channel_axis
-        self.reset()
-
-    @property
-    def trained(self) -> bool:
-        """Whether a sample has been learnt since the last :meth:`reset`."""
-        return self._numerator is not None
-
-    def reset(self) -> None:
-        """Forget the samples learnt."""
-        self._numerator = self._denominator = None
-
-    def learn(self, desired: np.ndarray, spectrum: np.ndarray) -> None:
-        """Blend in a sample with its desired response.
-
-        Parameters
-        ----------
-        desired : ndarray
-            Spectrum G of the desired response.
-        spectrum : ndarray
-            Spectra F_l of the sample's channels.
-        """
-        numerator = desired * np.conj(spectrum)
-        denominator = (spectrum * np.conj(spectrum)).real.sum(self.channel_axis)
-        if self._numerator is None:
-            self._numerator, self._denominator = numerator, denominator
-            return
-        eta = self.learning_rate
-        self._numerator = (1.0 - eta) * self._numerator + eta * numerator
-        self._denominator = (1.0 - eta) * self._denominator + eta * denominator
-
-    def response(self, spectrum: np.ndarray) -> np.ndarray:
-        """Spectrum of the filter's response to a sample, channels summed.
-
-        Parameters
-        ----------
-        spectrum : ndarray
-            Spectra of the sample's channels.
-
-        Returns
-        -------
-        ndarray
-            The response's spectrum.
-        """
-        return (self._numerator * spectrum).sum(self.channel_axis) / (self._denominator + self.regularization)
-
-
-def model_size(size, area: float, min_cells: int) -> tuple[int, int]:
-    """Size in model pixels of a window resampled to about ``area`` pixels with its aspect ratio.
+    Unturned (the usual case), the region is ``[round(cx) - w//2, round(cx) - w//2 + w)`` (STRCF's ``get_pixels``
+    with its rounded sample position); shrinking by ``f >= 2`` first averages ``k x k`` blocks, ``k = floor(f)``
+    (OpenCV's integer INTER_AREA; the region rounded to a multiple of k), then resamples bilinearly by the remaining
+    factor below 2, as the MATLAB trackers' ``mexResize(..., 'auto')`` averages over areas.  A turned region (the
+    gyro prior's camera roll) is warped bilinearly from the image shrunk by ``pyrDown`` until the remaining factor
+    is below 2, so that it is not aliased either.
 
     Parameters
     ----------
-    size : array_like
-        (w, h) of the window.
-    area : float
-        Number of model pixels aimed at.
-    min_cells : int
-        Least number of CELLs per axis.
-
-    Returns
-    -------
-    tuple of int
-        (w, h) in model pixels: whole CELLs, at least ``min_cells`` of them per axis.
-    """
-    w, h = (float(v) for v in size)
-    f = np.sqrt(area / (w * h))
-    return tuple(int(max(min_cells, round(v * f / CELL))) * CELL for v in (w, h))
-
-
-def hann(n: int) -> np.ndarray:
-    """Hann window of ``n`` samples without its zero ends (every sample keeps some weight).
-
-    Parameters
-    ----------
-    n : int
-        Number of samples.
+    img : ndarray
+        (H, W) or (H, W, 3) uint8 image.
+    centre : array_like
+        (cx, cy) of the region.
+    region_wh : array_like
+        (w, h) of the region in image pixels.
+    out_wh : array_like
+        (w, h) of the sample.
+    angle : float
+        Turn of the region's axes (radians; its x axis along (cos, sin)).
 
     Returns
     -------
     ndarray
-        (n,) weights.
+        The sample, (out_h, out_w[, 3]) uint8.
     """
-    return np.hanning(n + 2)[1:-1]
+    ow, oh = int(out_wh[0]), int(out_wh[1])
+    if angle == 0.0:
+        return _axis_aligned(img, centre, region_wh, ow, oh)
+    sx, sy = float(region_wh[0]) / ow, float(region_wh[1]) / oh
+    level = max(int(np.floor(np.log2(max(min(sx, sy), 1.0)))), 0)
+    src, f = img, 1.0
+    for _ in range(level):
+        if min(src.shape[:2]) < 4:
+            break
+        src, f = cv2.pyrDown(src), f * 2.0
+    linear = window_axes(angle) * [sx / f, sy / f]
+    c = (np.asarray(centre, dtype=np.float64) + 0.5) / f - 0.5
+    warp = np.column_stack([linear, c - linear @ [(ow - 1) / 2, (oh - 1) / 2]])
+    return cv2.warpAffine(src, warp, (ow, oh), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                          borderMode=cv2.BORDER_REPLICATE)
 
 
-def parabola_peak(left: float, centre: float, right: float) -> float:
-    """Sub-sample offset of a maximum: the vertex of the parabola through three samples around it.
+def _axis_aligned(img, centre, region_wh, ow: int, oh: int) -> np.ndarray:
+    sw = max(int(round(float(region_wh[0]))), 2)
+    sh = max(int(round(float(region_wh[1]))), 2)
+    k = int(min(sw / ow, sh / oh))
+    if k >= 2:
+        sw, sh = k * max(int(round(sw / k)), 1), k * max(int(round(sh / k)), 1)
+    x0 = int(round(float(centre[0]))) - sw // 2
+    y0 = int(round(float(centre[1]))) - sh // 2
+    crop = _crop(img, x0, y0, sw, sh)
+    if sw == ow and sh == oh:
+        return np.ascontiguousarray(crop)
+    if k >= 2:
+        crop = cv2.resize(crop, (sw // k, sh // k), interpolation=cv2.INTER_AREA)
+        if crop.shape[1] == ow and crop.shape[0] == oh:
+            return crop
+    return cv2.resize(crop, (ow, oh), interpolation=cv2.INTER_LINEAR)
+
+
+def _crop(img, x0: int, y0: int, sw: int, sh: int) -> np.ndarray:
+    """Integer crop ``[x0, x0 + sw) x [y0, y0 + sh)`` with the border pixels replicated outside the image."""
+    H, W = img.shape[:2]
+    x1, y1 = x0 + sw, y0 + sh
+    if x0 >= 0 and y0 >= 0 and x1 <= W and y1 <= H:
+        return img[y0:y1, x0:x1]
+    xa, xb, ya, yb = max(x0, 0), min(x1, W), max(y0, 0), min(y1, H)
+    if xa < xb and ya < yb:
+        return cv2.copyMakeBorder(img[ya:yb, xa:xb], ya - y0, y1 - yb, xa - x0, x1 - xb, cv2.BORDER_REPLICATE)
+    ix = np.clip(np.arange(x0, x1), 0, W - 1)  # entirely outside: the nearest border pixels
+    iy = np.clip(np.arange(y0, y1), 0, H - 1)
+    return img[iy[:, None], ix[None, :]]
+
+
+# ---------------------------------------------------------------------------------------------- windows, labels
+def hann_inner(n: int) -> np.ndarray:
+    """Hann window of length ``n`` without its zero end points (``hann(n + 2)(2:end-1)`` of BACF/AutoTrack)."""
+    k = np.arange(1, n + 1)
+    return (0.5 - 0.5 * np.cos(2 * np.pi * k / (n + 1))).astype(np.float32)
+
+
+def gaussian_label(rows: int, cols: int, sigma: float) -> np.ndarray:
+    """Gaussian of std ``sigma`` (cells) with its peak at index (0, 0), wrapped circularly (KCF/STRCF)."""
+    ry = np.roll(np.arange(rows) - (rows - 1) // 2, -((rows - 1) // 2))
+    rx = np.roll(np.arange(cols) - (cols - 1) // 2, -((cols - 1) // 2))
+    return np.exp(-0.5 * (ry[:, None] ** 2 + rx[None, :] ** 2) / sigma ** 2).astype(np.float32)
+
+
+# ---------------------------------------------------------------------------------------------- confidence
+def apce(resp: np.ndarray) -> float:
+    """Average peak-to-correlation energy ``|F_max - F_min|^2 / mean((F - F_min)^2)`` (LMCF, CVPR 2017, eq. 11)."""
+    mx, mn = float(resp.max()), float(resp.min())
+    den = float(np.mean((resp - mn) ** 2))
+    return (mx - mn) ** 2 / den if den > 0 else 0.0
+
+
+def peak_to_sidelobe(resp: np.ndarray, exclude: int = 2) -> float:
+    """MOSSE's peak-to-sidelobe ratio ``(max - mean) / std`` of the response outside the peak's
+    ``(2 exclude + 1)^2`` neighbourhood (circular)."""
+    r, c = np.unravel_index(int(np.argmax(resp)), resp.shape)
+    mask = np.ones(resp.shape, bool)
+    mask[np.ix_(np.arange(r - exclude, r + exclude + 1) % resp.shape[0],
+                np.arange(c - exclude, c + exclude + 1) % resp.shape[1])] = False
+    side = resp[mask]
+    sd = float(side.std())
+    return (float(resp[r, c]) - float(side.mean())) / sd if sd > 0 else 0.0
+
+
+class SubCellPeak:
+    """The response's maximum refined by Newton's method on its Fourier interpolant (SRDCF, Danelljan et al.,
+    ICCV 2015, sec. 4.2), from the rfft2 half spectrum ``R``.
+
+    ``r(Y, X) = 1/T Re sum c_kx R(ky, kx) exp(i (ky Y + kx X))`` with ``Y = 2 pi y / rows``, ``X = 2 pi x / cols``
+    and ``c_kx = 2`` for the frequencies whose conjugate is not stored.
 
     Parameters
     ----------
-    left, centre, right : float
-        Three consecutive samples, ``centre`` the maximum.
-
-    Returns
-    -------
-    float
-        Offset of the vertex from ``centre``, in samples, within +-0.5; 0 when the samples are not concave.
+    rows, cols : int
+        The response's shape.
+    iterations : int
+        Newton iterations (stopped early where the Hessian is not negative definite).
     """
-    curvature = left - 2.0 * centre + right
-    return 0.5 * (left - right) / curvature if curvature < 0 else 0.0
+
+    def __init__(self, rows: int, cols: int, iterations: int = 5):
+        self.rows, self.cols, self.iterations = rows, cols, iterations
+        self.ky = (np.fft.fftfreq(rows) * rows).astype(np.float64)
+        half = cols // 2 + 1
+        self.kx = np.arange(half, dtype=np.float64)
+        self.c = np.full(half, 2.0)
+        self.c[0] = 1.0
+        if cols % 2 == 0:
+            self.c[-1] = 1.0
+        self.T = rows * cols
+
+    def __call__(self, resp: np.ndarray, rf: np.ndarray) -> tuple[float, float, float]:
+        """``(dy, dx, value)``: the peak's displacement in cells from the origin (signed, circular) and the
+        interpolated response there."""
+        rows, cols = self.rows, self.cols
+        idx = int(np.argmax(resp))
+        r0, c0 = divmod(idx, cols)
+        v0 = float(resp.flat[idx])
+        ty = (r0 + (rows - 1) // 2) % rows - (rows - 1) // 2
+        tx = (c0 + (cols - 1) // 2) % cols - (cols - 1) // 2
+        Y0, X0 = 2 * np.pi * ty / rows, 2 * np.pi * tx / cols
+        Y, X, v = _newton(rf, self.ky, self.kx, self.c, Y0, X0, self.iterations)
+        v /= self.T
+        if not np.isfinite(v) or v <= v0:  # no ascent (a saddle at the integer peak): a parabola per axis instead
+            return ty + _vertex(resp[(r0 - 1) % rows, c0], v0, resp[(r0 + 1) % rows, c0]), \
+                tx + _vertex(resp[r0, (c0 - 1) % cols], v0, resp[r0, (c0 + 1) % cols]), v0
+        dy = (np.mod(Y + np.pi, 2 * np.pi) - np.pi) / (2 * np.pi) * rows
+        dx = (np.mod(X + np.pi, 2 * np.pi) - np.pi) / (2 * np.pi) * cols
+        return float(dy), float(dx), float(v)
 
 
-def orientation_histograms(windows: np.ndarray) -> np.ndarray:
-    """Gradient-orientation histograms of each window, as one vector per window.
-
-    Central-difference gradients (one-sided at the border); unsigned orientations in ``N_ORIENTATIONS`` bins, weighted
-    by the gradient magnitude, summed over CELL x CELL cells; each cell's histogram divided by its L2 norm plus a floor
-    (flat cells stay short): a HOG without blocks, invariant to brightness and contrast.
-
-    Parameters
-    ----------
-    windows : ndarray
-        (S, H, W) windows; H and W are multiples of CELL.
-
-    Returns
-    -------
-    ndarray
-        (S, d) features.
-
-    Raises
-    ------
-    ValueError
-        When H or W is not a multiple of CELL.
-    """
-    windows = np.ascontiguousarray(windows, dtype=np.float32)
-    n, h, w = windows.shape
-    if h % CELL or w % CELL:
-        raise ValueError(f"window size {w}x{h} is not a multiple of the {CELL} px cell")
-    return _orientation_histograms(windows).reshape(n, -1)
+def _vertex(left: float, centre: float, right: float) -> float:
+    """Offset in (-0.5, 0.5) of the vertex of the parabola through three samples around their maximum."""
+    den = left - 2.0 * centre + right
+    return float(np.clip(0.5 * (left - right) / den, -0.5, 0.5)) if den < 0 else 0.0
 
 
-_BOUNDARY_COS = np.cos(np.arange(N_ORIENTATIONS) * np.pi / N_ORIENTATIONS)
-_BOUNDARY_SIN = np.sin(np.arange(N_ORIENTATIONS) * np.pi / N_ORIENTATIONS)
+@numba.njit(cache=True, nogil=True)
+def _newton(R, ky, kx, c, Y, X, iterations):
+    """Newton iterations on ``F(Y, X) = Re sum_ab R_ab c_b exp(i (ky_a Y + kx_b X))``; (Y, X, F(Y, X))."""
+    H, Wh = R.shape
+    ex = np.empty(Wh, np.complex128)
+    v = 0.0
+    for it in range(iterations + 1):
+        for b in range(Wh):
+            ex[b] = c[b] * np.exp(1j * kx[b] * X)
+        v = gy = gx = hyy = hxx = hxy = 0.0
+        for a in range(H):
+            s0 = s1 = s2 = 0j
+            for b in range(Wh):
+                t = ex[b] * R[a, b]
+                s0 += t
+                s1 += kx[b] * t
+                s2 += kx[b] * kx[b] * t
+            ey = np.exp(1j * ky[a] * Y)
+            t0, t1, t2 = ey * s0, ey * s1, ey * s2
+            v += t0.real
+            gy -= ky[a] * t0.imag
+            gx -= t1.imag
+            hyy -= ky[a] * ky[a] * t0.real
+            hxx -= t2.real
+            hxy -= ky[a] * t1.real
+        if it == iterations:
+            break
+        det = hyy * hxx - hxy * hxy
+        if not (det > 0 and hyy < 0):
+            break
+        Y = Y - (hxx * gy - hxy * gx) / det
+        X = X - (hyy * gx - hxy * gy) / det
+    return Y, X, v
 
 
-@numba.njit(cache=True)
-def _orientation_histograms(windows):
-    n, h, w = windows.shape
-    n_rows, n_cols = h // CELL, w // CELL
-    hist = np.zeros((n, n_rows, n_cols, N_ORIENTATIONS))
-    for k in range(n):
-        for y in range(h):
-            y0, y1 = max(y - 1, 0), min(y + 1, h - 1)
-            for x in range(w):
-                x0, x1 = max(x - 1, 0), min(x + 1, w - 1)
-                gx = (windows[k, y, x1] - windows[k, y, x0]) / (x1 - x0)
-                gy = (windows[k, y1, x] - windows[k, y0, x]) / (y1 - y0)
-                if gy < 0.0 or (gy == 0.0 and gx < 0.0):  # unsigned: fold onto [0, pi)
-                    gx, gy = -gx, -gy
-                # The bin: the last boundary at or below the orientation, i.e. the number of boundaries 1..8 it is
-                # at or above (on [0, pi) "at or above boundary b" holds for b up to the bin and fails after it),
-                # counted without branches.
-                b = 0
-                for boundary in range(1, N_ORIENTATIONS):
-                    b += gy * _BOUNDARY_COS[boundary] >= gx * _BOUNDARY_SIN[boundary]
-                hist[k, y // CELL, x // CELL, b] += np.sqrt(gx * gx + gy * gy)
-    for k in range(n):
-        for r in range(n_rows):
-            for c in range(n_cols):
-                norm = 0.0
-                for b in range(N_ORIENTATIONS):
-                    norm += hist[k, r, c, b] ** 2
-                scale = 1.0 / (np.sqrt(norm) + FLOOR)
-                for b in range(N_ORIENTATIONS):
-                    hist[k, r, c, b] *= scale
-    return hist
+# ---------------------------------------------------------------------------------------------- spectral kernels
+@numba.njit(cache=True, fastmath=True, nogil=True)
+def energy(xf, out):
+    """``out[i, j] = sum_d |xf[d, i, j]|^2``."""
+    C, H, W = xf.shape
+    out[:, :] = 0.0
+    for d in range(C):
+        for i in range(H):
+            for j in range(W):
+                v = xf[d, i, j]
+                out[i, j] += v.real * v.real + v.imag * v.imag
+
+
+@numba.njit(cache=True, fastmath=True, nogil=True)
+def correlate(f, z, out):
+    """``out[i, j] = sum_d conj(f[d, i, j]) z[d, i, j]``: the response spectrum of filter ``f`` on sample ``z``."""
+    C, H, W = f.shape
+    out[:, :] = 0.0
+    for d in range(C):
+        for i in range(H):
+            for j in range(W):
+                out[i, j] += np.conj(f[d, i, j]) * z[d, i, j]

@@ -1,153 +1,136 @@
-"""Discriminative scale estimation: a one-dimensional correlation filter over scales (DSST).
+"""Discriminative scale estimation: fDSST's one-dimensional correlation filter over scales.
 
 The EMD of the iEMD histograms hardly changes with the window's scale: its patch positions are in normalized window
 units and its patches are normalized, so a window somewhat too large or too small scores almost the same EMD
-(docs/decisions.md#scale-estimator).  This is Danelljan et al.'s scale filter ("Accurate Scale Estimation for Robust
-Visual Tracking", BMVC 2014): the window at ``n_scales`` scales ``scale_step**k`` around the current size is
-resampled to one small model size and described by gradient-orientation histograms; the features of the scales,
-tapered by a Hann window over the scale axis, form a d x S sample whose desired response is a Gaussian peaked at the
-current scale.  The filter (eq. 5 of DSST, solved in the Fourier domain along the scale axis) and its running
-average (learning rate eta) give, on the next frame, the scale whose response peaks.  All scales are sampled from
-one pyramid level, so their smoothing differs by the scale only, and the filter learns from the estimate's own
-sample.
+(docs/decisions.md#scale-estimator).  This is the scale filter of fDSST (Danelljan, Hager, Shahbaz Khan, Felsberg,
+"Discriminative Scale Space Tracking", TPAMI 2017, sec. 4-5): ``N_SCALES`` samples of the window at sizes
+``step^e_k`` (``e_k`` spaced by ``N_INTERP / N_SCALES`` interpolated steps) resampled to one model size of area
+``MODEL_AREA`` and described by fHOG, one column per scale times a Hann window over the scales; a 1-D filter over
+the scales (eqs. 5-6; the template a running average at ``LEARNING_RATE``, eq. 21), its response zero-padded to
+``N_INTERP`` scales (sec. 5.3) and the peak refined by a parabola (ECO-HC).  fDSST's QR compression to ``N_SCALES``
+dimensions (eqs. 22-23) leaves the response unchanged; it is computed exactly from a Gram matrix instead.
 """
 from __future__ import annotations
 
+import cv2
 import numpy as np
 
-from iemd_ros.tracking.appearance import ImagePyramid
-from iemd_ros.tracking.correlation_filter import FilterModel, hann, model_size, orientation_histograms, parabola_peak
+from iemd_ros.tracking import features
+from iemd_ros.tracking.correlation_filter import sample_region
+
+__all__ = ["ScaleFilter"]
+
+N_SCALES = 17
+N_INTERP = 33
+SIGMA_FACTOR = 1.0 / 16
+REGULARIZATION = 1e-2
+LEARNING_RATE = 0.025
+MODEL_AREA = 32.0 * 16.0  # px^2 of the model size the scale samples are resampled to
 
 
 class ScaleFilter:
-    """DSST scale filter (see the module docstring).
-
-    ``init`` at the target's window, then per frame ``estimate`` and, when the frame is tracked, ``update``.  Windows
-    are (centre, size (w, h), angle) as in :meth:`ImagePyramid.sample`.  ``update`` learns from the sample ``estimate``
-    took, its desired response centred on the estimated scale (a shift along the scale axis, a phase in the Fourier
-    domain) rather than from a second sample at the new size as DSST does: one sample per frame instead of two.
+    """fDSST's scale filter (see the module docstring).
 
     Parameters
     ----------
-    n_scales : int, optional
-        Number of scales S, odd and >= 3.
-    scale_step : float, optional
-        Ratio of consecutive scales, > 1: the scales are ``scale_step**k`` around the current size.
-    learning_rate : float, optional
-        Rate eta of the filter's running average, in (0, 1].
-    regularization : float, optional
-        Added to the filter's denominator.
-    sigma : float, optional
-        Width of the desired Gaussian response over the scale index, in scale steps (DSST's 33 / sqrt(33) / 4).
-    model_area : int, optional
-        About how many pixels each scaled window is resampled to.
-
-    Raises
-    ------
-    ValueError
-        For an even ``n_scales`` or one below 3, a ``scale_step`` not above 1, or a ``learning_rate`` outside (0, 1].
+    scale_step : float
+        Ratio between neighbouring interpolated scales (``1 + TrackerConfig.scale_step``).
     """
 
-    def __init__(self, n_scales: int = 33, scale_step: float = 1.02, learning_rate: float = 0.025,
-                 regularization: float = 0.01, sigma: float = 1.4375, model_area: int = 512):
-        if n_scales < 3 or n_scales % 2 == 0:
-            raise ValueError(f"n_scales must be odd and >= 3, got {n_scales}")
+    def __init__(self, scale_step: float = 1.02):
         if not scale_step > 1.0:
             raise ValueError(f"scale_step must be > 1, got {scale_step}")
-        offsets = np.arange(n_scales) - n_scales // 2
-        self.step = scale_step
-        self.factors = scale_step ** offsets  # relative scales, ascending; the middle one is 1
-        # Desired response: a Gaussian over the scale index (sigma in scale steps: DSST's 33 / sqrt(33) / 4)
-        # peaked at the middle, and the frequencies that shift it.
-        self._desired = np.fft.fft(np.exp(-0.5 * (offsets / sigma) ** 2))
-        self._frequencies = 2.0 * np.pi * np.fft.fftfreq(n_scales)
-        self._taper = hann(n_scales)  # over the scales
-        self.model_area = model_area
-        self.model_size = None  # (w, h) of the resampled windows, multiples of CELL
-        self._filter = FilterModel(learning_rate, regularization, channel_axis=0)  # spectra (d, S)
-        self._last = None  # (spectrum, estimated shift in scale steps) of the last estimate
-
-    def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
-        """Learn the filter from the window (``center``, ``size``) of the first frame.
-
-        Parameters
-        ----------
-        pyramid : ImagePyramid
-            The first frame.
-        center : array_like
-            (x, y) window centre, image pixels.
-        size : array_like
-            (w, h) window size, image pixels.
-        angle : float, optional
-            The window's turn, radians.
-        """
-        self.model_size = model_size(size, self.model_area, min_cells=2)
-        self._filter.reset()
-        self._learn(self._spectrum(pyramid, center, size, angle), 0.0)
+        exps = (np.arange(N_SCALES) - (N_SCALES - 1) // 2) * N_INTERP / N_SCALES
+        exps_shifted = np.roll(exps, -((N_SCALES - 1) // 2))
+        interp = np.roll(np.arange(N_INTERP) - (N_INTERP - 1) // 2, -((N_INTERP - 1) // 2))
+        self.size_factors = scale_step ** exps
+        self.interp_factors = scale_step ** interp
+        sigma = N_INTERP * SIGMA_FACTOR
+        self.label_f = np.fft.fft(np.exp(-0.5 * exps_shifted ** 2 / sigma ** 2))
+        self.window = 0.5 - 0.5 * np.cos(2 * np.pi * np.arange(N_SCALES) / (N_SCALES - 1))  # MATLAB's hann(n)
+        k = np.arange(N_SCALES)
+        self._diagonals = (np.broadcast_to(k[None, :], (N_SCALES, N_SCALES)), (k[None, :] + k[:, None]) % N_SCALES)
+        self.template = self.denominator = None
         self._last = None
 
-    def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0, bounds=None) -> float:
-        """Relative scale of the target in ``pyramid``'s frame against the window ``size`` at ``center``.
+    def init(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
+        """Fix the model size (the first window's, scaled to ``MODEL_AREA``) and learn on the first window."""
+        w, h = float(size[0]), float(size[1])
+        f = np.sqrt(MODEL_AREA / (w * h))
+        self.model_wh = (max(int(np.floor(w * f)), 8), max(int(np.floor(h * f)), 8))
+        self.template = self.denominator = None
+        self.update(frame, center, size, angle)
 
-        The factor where the filter response peaks, refined between scales by a parabola through the peak.  ``update``
-        learns at the scale returned.
+    def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0, bounds=(0.0, np.inf)) -> float:
+        """The relative scale of the target at the window (``center``, ``size``, ``angle``), within ``bounds``
+        (lowest, highest)."""
+        if self.template is None:
+            raise RuntimeError("ScaleFilter.estimate() needs init() first")
+        z = self._sample(frame, center, size, angle)
+        rf = self.label_f * self._correlation_f(self.template, z) / (self.denominator + REGULARIZATION)
+        pad = np.zeros(N_INTERP, complex)  # fDSST's resizeDFT: the spectrum zero-padded to N_INTERP samples
+        npos = (N_SCALES + 1) // 2
+        pad[:npos] = rf[:npos]
+        pad[N_INTERP - (N_SCALES - npos):] = rf[npos:]
+        resp = np.real(np.fft.ifft(pad)) * N_INTERP / N_SCALES
+        i = int(np.argmax(resp))
+        scale = _parabola_peak(self.interp_factors[[(i - 1) % N_INTERP, i, (i + 1) % N_INTERP]],
+                               resp[[(i - 1) % N_INTERP, i, (i + 1) % N_INTERP]])
+        return float(np.clip(scale, bounds[0], bounds[1]))
 
-        Parameters
-        ----------
-        pyramid : ImagePyramid
-            The frame.
-        center, size : array_like
-            The window, as in :meth:`init`.
-        angle : float, optional
-            The window's turn, radians.
-        bounds : tuple of float, optional
-            (lowest, highest) factor the estimate is limited to.
+    def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
+        """Learn on the scale samples of the window (``center``, ``size``, ``angle``) of ``frame`` (eqs. 5-6, 21)."""
+        x = self._sample(frame, center, size, angle)
+        denominator = np.real(self._correlation_f(x, x))
+        if self.template is None:
+            self.template, self.denominator = x, denominator
+        else:
+            self.template = (1 - LEARNING_RATE) * self.template + LEARNING_RATE * x
+            self.denominator = (1 - LEARNING_RATE) * self.denominator + LEARNING_RATE * denominator
 
-        Returns
-        -------
-        float
-            The relative scale factor.
+    def _correlation_f(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """DFT over the scales of ``c(m) = sum_k sum_d a~_d(k) b~_d(k + m)`` (``~``: times the scale window), from
+        the Gram matrix ``a~^T b~``: the QR-compressed correlation of fDSST, which it equals."""
+        G = (a.T @ b) * (self.window[:, None] * self.window[None, :])
+        return np.fft.fft(G[self._diagonals].sum(axis=1))
 
-        Raises
-        ------
-        RuntimeError
-            Before :meth:`init`.
-        """
-        if not self._filter.trained:
-            raise RuntimeError("ScaleFilter.estimate() called before init()")
-        spectrum = self._spectrum(pyramid, center, size, angle)
-        response = np.fft.ifft(self._filter.response(spectrum)).real
-        peak = int(np.argmax(response))
-        shift = peak - len(response) // 2
-        if 0 < peak < len(response) - 1:
-            shift += parabola_peak(*response[peak - 1:peak + 2])
-        if bounds is not None:
-            shift = float(np.clip(shift, *(np.log(bounds) / np.log(self.step))))
-        self._last = (spectrum, shift)
-        return float(self.step**shift)
+    def _sample(self, frame: np.ndarray, center, size, angle: float) -> np.ndarray:
+        """(D, N_SCALES) fHOG columns of the scale samples: one region covering the largest scale is sampled once
+        at the resolution the smallest needs, then each scale is a bilinear warp of it to the model size."""
+        mw, mh = self.model_wh
+        tw, th = float(size[0]), float(size[1])
+        smin, smax = float(self.size_factors.min()), float(self.size_factors.max())
+        sw, sh = int(round(tw * smax)) + 4, int(round(th * smax)) + 4
+        ow = max(int(np.ceil(sw * min(1.0, mw / (tw * smin)))), 2)
+        oh = max(int(np.ceil(sh * min(1.0, mh / (th * smin)))), 2)
+        pos = np.round(np.asarray(center, dtype=np.float64)) if angle == 0.0 else np.asarray(center, float)
+        region = sample_region(frame, pos, (sw, sh), (ow, oh), angle)
+        ax, ay = ow / sw, oh / sh
+        # the region's corner (a turned region is centred exactly on pos, in its own axes)
+        x0, y0 = (pos[0] - sw // 2, pos[1] - sh // 2) if angle == 0.0 else (pos[0] - sw / 2, pos[1] - sh / 2)
+        patches = np.empty((N_SCALES, mh, mw) + region.shape[2:], region.dtype)
+        M = np.zeros((2, 3))
+        for k, s in enumerate(self.size_factors):
+            pw, ph = max(np.floor(tw * s), 1.0), max(np.floor(th * s), 1.0)
+            if angle == 0.0:
+                x0k, y0k = pos[0] - int(pw) // 2, pos[1] - int(ph) // 2
+            else:
+                x0k, y0k = pos[0] - pw / 2, pos[1] - ph / 2
+            M[0, 0], M[0, 2] = pw / mw * ax, ((x0k - x0) + 0.5 * pw / mw) * ax - 0.5
+            M[1, 1], M[1, 2] = ph / mh * ay, ((y0k - y0) + 0.5 * ph / mh) * ay - 0.5
+            patches[k] = cv2.warpAffine(region, M, (mw, mh), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+                                        borderMode=cv2.BORDER_REPLICATE)
+        return features.fhog_batch(patches).reshape(N_SCALES, -1).T.astype(np.float64)
 
-    def update(self) -> None:
-        """Blend the last estimate's sample in (the running average of DSST eq. 5).
 
-        Its desired response is peaked at the scale it estimated.
-
-        Raises
-        ------
-        RuntimeError
-            Without an :meth:`estimate` since :meth:`init` or the last update.
-        """
-        if self._last is None:
-            raise RuntimeError("ScaleFilter.update() needs an estimate() first")
-        self._learn(*self._last)
-        self._last = None
-
-    # ------------------------------------------------------------ internals
-    def _learn(self, spectrum: np.ndarray, shift: float) -> None:
-        self._filter.learn(self._desired * np.exp(-1j * self._frequencies * shift), spectrum)
-
-    def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
-        """FFT along the scales of the (d, S) sample: per scale, the window at that scale resampled to the
-        model size and described by :func:`orientation_histograms`, tapered by the Hann window over the scales."""
-        size = np.asarray(size, dtype=np.float64)
-        windows = pyramid.sample_scales(center, size, self.model_size, self.factors, angle)
-        return np.fft.fft(orientation_histograms(windows).T * self._taper, axis=1)
+def _parabola_peak(xs: np.ndarray, ys: np.ndarray) -> float:
+    """The maximum of the parabola through three (scale, response) points, within their range; the middle scale
+    when the parabola opens upward or the system is singular."""
+    A = np.stack([xs ** 2, xs, np.ones(3)], axis=1)
+    try:
+        p = np.linalg.solve(A, ys)
+    except np.linalg.LinAlgError:
+        return float(xs[1])
+    if p[0] >= 0:
+        return float(xs[1])
+    return float(np.clip(-p[1] / (2 * p[0]), xs.min(), xs.max()))

@@ -143,11 +143,11 @@ class IemdTracker:
         self._scale_filter = None
         if cfg.scale_estimator is ScaleEstimator.FILTER and cfg.scale_step > 0:
             self._scale_filter = ScaleFilter(scale_step=1.0 + cfg.scale_step)
-            self._scale_filter.init(pyramid, self._center, self._size)
+            self._scale_filter.init(frame, self._center, self._size)
         self._translation_filter = None
         if cfg.translation_weight > 0:
             self._translation_filter = TranslationFilter()
-            self._translation_filter.init(pyramid, self._center, self._size)
+            self._translation_filter.init(frame, self._center, self._size, _is_colour(frame))
         self._colour_model = None
         if cfg.colour_weight > 0 and _is_colour(frame):
             self._colour_model = ColourModel()
@@ -190,10 +190,16 @@ class IemdTracker:
         self._frame_index += 1
         predicted = _box(center, size, angle)
         previous, grey, pyramid = self._take_frame(frame)
+        visible = _visible_fraction(center, size, angle, frame.shape)
+        if visible < self.config.min_visible:  # the prior moved the window out of view: keep its place, search nothing
+            self._center, self._size, self._angle, self._lost = center, size, angle, True
+            return TrackResult(box=predicted, emd=float("inf"), iterations=0, lost=True, angle=angle, starts=0,
+                               predicted_box=predicted, cause=Cause.OUT_OF_VIEW,
+                               reason=f"only {visible:.0%} of the predicted window is inside the image")
         best, searches, starts = self._search_all(frame, previous, grey, pyramid, prior, center, size, angle)
         final, scale = _Descent(model=best.model, emd=best.emd), 1.0  # a held frame keeps the window's size
         if not best.held_reason:
-            final, scale = self._estimate_scale(pyramid, best, _scale_bounds(best.model.size, frame.shape))
+            final, scale = self._estimate_scale(frame, best, _scale_bounds(best.model.size, frame.shape))
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
         cause, reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
         lost = self._lost = cause is not None
@@ -201,7 +207,7 @@ class IemdTracker:
         if not lost:
             self._center, self._size, self._angle = new_center, new_size, angle
         if not lost and not held:
-            self._learn(frame, pyramid, final, best.confidence, new_center, new_size, angle)
+            self._learn(frame, final, best.confidence, new_center, new_size, angle)
         if held:
             cause, reason = Cause.LOW_RESPONSE, best.held_reason
         return TrackResult(
@@ -221,7 +227,7 @@ class IemdTracker:
             moves.append(window_flow(previous, grey, _box(self._center, self._size, self._angle), prior,
                                      cfg.flow_max_error))
         if self._translation_filter is not None:
-            moves.append(self._translation_filter.estimate(pyramid, center, size, angle))
+            moves.append(self._translation_filter.estimate(frame, center, size, angle))
         self._colour_now = self._colour_model is not None and frame.ndim == 3
         if self._colour_now:
             moves.append(self._colour_model.estimate(frame, center, size, angle))
@@ -238,24 +244,24 @@ class IemdTracker:
                 best = candidate
         return best, searches, starts
 
-    def _estimate_scale(self, pyramid, best: _Descent, bounds) -> tuple[_Descent, float]:
+    def _estimate_scale(self, frame, best: _Descent, bounds) -> tuple[_Descent, float]:
         """(window, relative scale) at the converged window: the scale filter's estimate, the window not solved
         again at the new size (docs/decisions.md#scale-no-resolve), or the paper's EMD variants."""
         if self._scale_filter is not None:
-            scale = self._scale_filter.estimate(pyramid, best.center, best.model.size, best.model.angle, bounds)
+            scale = self._scale_filter.estimate(frame, best.center, best.model.size, best.model.angle, bounds)
             return _Descent(model=best.model, emd=best.emd), scale
         return self._search_scale(best, bounds)
 
-    def _learn(self, frame, pyramid, final: _Descent, confidence, center, size, angle) -> None:
+    def _learn(self, frame, final: _Descent, confidence, center, size, angle) -> None:
         """Every model learns the window of a tracked frame: the response's running mean, both filters, the colour
         histograms and the template dictionary (Algorithm 2)."""
         if confidence is not None:
             self._confidence = confidence if self._confidence is None else (
                 (1.0 - CONFIDENCE_RATE) * self._confidence + CONFIDENCE_RATE * confidence)
         if self._scale_filter is not None:
-            self._scale_filter.update()
+            self._scale_filter.update(frame, center, size, angle)
         if self._translation_filter is not None:
-            self._translation_filter.update(pyramid, center, size, angle)
+            self._translation_filter.update(frame, center, size, angle)
         if self._colour_now:
             self._colour_model.update(frame, center, size, angle)
         if self.config.update_templates and self.dictionary.observe(final.model.template, final.emd,

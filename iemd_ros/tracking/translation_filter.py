@@ -1,180 +1,245 @@
-"""Discriminative evidence of the window's position: a correlation filter over a search region (DSST/MOSSE).
+"""Discriminative evidence of the window's position: a spatial-temporal regularized correlation filter (STRCF).
 
 The iEMD histograms are a generative model with no notion of background: where the target turns or is partly
-hidden, a window on background or on a similar object can score an EMD as low as the target's, so the EMD alone
-cannot choose between the starting points Algorithm 1 descends from.  A correlation filter trained on the target
-against its own surroundings is the complementary view (docs/decisions.md#translation-filter).
+hidden, a window on background or on a similar object can score an EMD as low as the target's.  A correlation
+filter trained on the target against its own surroundings is the complementary view (docs/decisions.md#strcf).
 
-The filter is DSST's translation filter (Danelljan et al., BMVC 2014; MOSSE with several channels): the window
-padded by ``padding`` on each axis is resampled to about ``model_area`` pixels and described by the
-gradient-orientation histograms of :func:`iemd_ros.tracking.correlation_filter.orientation_histograms` (cells of 4
-model pixels), tapered by a Hann window; the desired response is a Gaussian of ``sigma_factor`` times the target's
-size (in cells) at the window centre.  ``estimate`` gives the displacement where the response peaks and keeps the
-response map, which ``response_at`` reads at any window centre.
+* Features (:mod:`iemd_ros.tracking.features`): grey + fHOG + Colour Names on 4x4 cells (42 channels; 32 on grey
+  frames), the feature set of STRCF and AutoTrack.
+* Sample: a square region of side ``SEARCH_AREA_SCALE`` x ``sqrt(w h)`` of the target, turned with the window,
+  resampled so that its area lies in ``[150^2, 160^2]`` px (at most 40 x 40 cells); a cosine window; a Gaussian
+  label of std ``sqrt(w h) / cell / 16`` cells.
+* Filter: STRCF (Li, Tian, Zuo, Zhang, Yang, "Learning Spatial-Temporal Regularized Correlation Filters for Visual
+  Tracking", CVPR 2018).  Each learning frame minimizes (STRCF eq. 3)
+  ``E(f) = 1/(2T) ||sum_d x_d (*) f_d - y||^2 + 1/2 sum_d ||w . f_d||^2 + mu/2 sum_d ||f_d - f_{t-1,d}||^2``
+  with the binary window ``w`` of BACF (Kiani Galoogahi et al., ICCV 2017): ``1e-3`` on the target's cells,
+  ``1e5`` elsewhere, so that every circular shift of the padded sample is a real background negative.  ADMM on
+  ``f = g`` (STRCF eqs. 5-10), 2 iterations: the f-step per frequency by Sherman-Morrison (eq. 8), the g-step
+  element-wise in space (eq. 9), the multiplier update (eq. 10).  The training sample is the detection sample
+  circularly shifted to the new centre in the Fourier domain (AutoTrack's ``shift_sample``).
+* Detection: the response ``r = F^-1(sum_d conj(f_d^) z_d^)`` on the cell grid, its peak refined by Newton's method
+  on the Fourier interpolant (SRDCF); :meth:`TranslationFilter.response_at` reads it at any window centre.
 """
 from __future__ import annotations
 
+import numba
 import numpy as np
+import scipy.fft as sfft
 
-from iemd_ros.tracking.appearance import ImagePyramid, window_axes
-from iemd_ros.tracking.correlation_filter import CELL, FilterModel, hann, model_size, orientation_histograms, parabola_peak
+from iemd_ros.tracking import features
+from iemd_ros.tracking.appearance import window_axes
+from iemd_ros.tracking.correlation_filter import (SubCellPeak, apce, correlate, energy, gaussian_label, hann_inner,
+                                                 sample_region)
+
+__all__ = ["TranslationFilter", "SEARCH_AREA_SCALE"]
+
+SEARCH_AREA_SCALE = 5.0                       # side of the search region / sqrt(w h) (STRCF, BACF)
+SAMPLE_AREA = (150.0 ** 2, 160.0 ** 2)        # area bounds of the resampled region, px^2
+OUTPUT_SIGMA_FACTOR = 1.0 / 16                # label std / sqrt(w h) in cells (STRCF)
+REG_TARGET, REG_BACKGROUND = 1e-3, 1e5        # BACF's binary spatial regularization
+MU = 15.0                                     # STRCF's temporal regularization
+ADMM_ITERATIONS = 2
+GAMMA_INIT, GAMMA_STEP, GAMMA_MAX = 1.0, 10.0, 0.1  # ADMM penalty schedule (STRCF)
 
 
 class TranslationFilter:
-    """DSST's translation filter (see the module docstring).
+    """STRCF over the search region around the window (see the module docstring).
 
-    ``init`` at the target's window, per frame ``estimate`` at the predicted window (then ``response_at`` for candidate
-    centres) and, when the frame is tracked, ``update`` at the tracked window.  Windows are (centre, size (w, h), angle)
-    as in :meth:`ImagePyramid.sample`.
-
-    Parameters
-    ----------
-    padding : float, optional
-        The search region is the window's size times 1 + ``padding`` on each axis; >= 0.
-    learning_rate : float, optional
-        Rate of the filter's running average, in (0, 1].
-    regularization : float, optional
-        Added to the filter's denominator.
-    sigma_factor : float, optional
-        Width of the desired Gaussian response, times the target's size in cells.
-    model_area : int, optional
-        About how many pixels the search region is resampled to.
-
-    Raises
-    ------
-    ValueError
-        For a negative ``padding`` or a ``learning_rate`` outside (0, 1].
+    The filter keeps no position of its own: :meth:`estimate` and :meth:`update` take the window from the caller,
+    which fuses the response with its other cues first.
     """
 
-    def __init__(self, padding: float = 1.5, learning_rate: float = 0.025, regularization: float = 0.01,
-                 sigma_factor: float = 0.1, model_area: int = 4096):
-        if padding < 0:
-            raise ValueError(f"padding must be >= 0, got {padding}")
-        self.padding = padding
-        self.sigma_factor = sigma_factor
-        self.model_area = model_area
-        self.model_size = None  # (w, h) of the resampled search region, multiples of CELL
-        self._filter = FilterModel(learning_rate, regularization, channel_axis=-1)  # spectra (rows, cols, d)
-        self._response = None  # (response map, centre, cell size in image px, angle) of the last estimate
+    def __init__(self):
+        self.f = None
+        self._detection = self._response = None
+        self.confidence = {}
 
-    def init(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
-        """Learn the filter from the window (``center``, ``size``) of the first frame.
+    def init(self, frame: np.ndarray, center, size, colour: bool, angle: float = 0.0) -> None:
+        """Set up the sample geometry from the first window and learn the first filter (``mu = 0``).
 
         Parameters
         ----------
-        pyramid : ImagePyramid
-            The frame.
-        center : array_like
-            (x, y) window centre, image pixels.
-        size : array_like
-            (w, h) window size, image pixels.
-        angle : float, optional
-            The window's turn, radians.
+        frame : ndarray
+            HxW or HxWx3 (BGR) uint8 frame.
+        center, size : array_like
+            The window's centre (cx, cy) and size (w, h), px.
+        colour : bool
+            Whether the sequence has colour (Colour Names are used on colour frames only).
+        angle : float
+            The window's turn (radians).
         """
-        self.model_size = model_size(self._region(size), self.model_area, min_cells=4)
-        cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
-        self._taper = np.outer(hann(rows), hann(cols))[..., None]
-        sigma = self.sigma_factor * np.sqrt(cols * rows) / (1.0 + self.padding)
-        ys, xs = np.arange(rows) - rows // 2, np.arange(cols) - cols // 2
-        peak = np.exp(-0.5 * (ys[:, None] ** 2 + xs[None, :] ** 2) / sigma**2)
-        self._desired = np.fft.fft2(np.fft.ifftshift(peak))[..., None]  # peak at cell (0, 0)
-        self._filter.reset()
-        self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
-        self._response = None
+        w, h = max(float(size[0]), 1.0), max(float(size[1]), 1.0)
+        self.colour = bool(colour)
+        area = w * h * SEARCH_AREA_SCALE ** 2
+        s0 = np.sqrt(area / np.clip(area, *SAMPLE_AREA))
+        self.base_wh = np.array([w, h]) / s0              # the target's size in the resampled sample, px
+        n = max(int(round(np.sqrt(np.prod(self.base_wh)) * SEARCH_AREA_SCALE / features.CELL)), 8)
+        self.map_hw = (n, n)
+        self.support = float(n * features.CELL)            # the resampled sample's side, px
+        self.T = n * n
+        self.window = (hann_inner(n)[:, None] * hann_inner(n)[None, :]).astype(np.float32)
+        cells = np.floor(self.base_wh / features.CELL)
+        sigma = max(float(np.sqrt(np.prod(cells))) * OUTPUT_SIGMA_FACTOR, 1e-3)
+        self.yf_conj = np.conj(sfft.rfft2(gaussian_label(n, n, sigma))).astype(np.complex64)
+        reg = np.full((n, n), REG_BACKGROUND)
+        rw, rh = max(int(cells[0]), 1), max(int(cells[1]), 1)
+        ys = np.clip(np.arange(rh) - rh // 2 + n // 2, 0, n - 1)
+        xs = np.clip(np.arange(rw) - rw // 2 + n // 2, 0, n - 1)
+        reg[np.ix_(ys, xs)] = REG_TARGET
+        self.reg_sq = (reg ** 2).astype(np.float32)
+        self.peak = SubCellPeak(n, n)
+        self.ky = (np.fft.fftfreq(n) * n).astype(np.float32)
+        self.kx = np.arange(n // 2 + 1, dtype=np.float32)
+        self.f = None
+        self._detection = self._response = None
+        self.update(frame, center, size, angle)
 
-    def estimate(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> np.ndarray:
-        """Displacement to where the response peaks in the region around the window (``center``, ``size``).
-
-        The peak is refined between cells by a parabola through it; the response map is kept for :meth:`response_at`.
+    # ------------------------------------------------------------------ detection
+    def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
+        """Where the response of the current filter peaks, as a displacement (dx, dy) px from ``center``; the
+        response is kept for :meth:`response_at` and :attr:`confidence`.
 
         Parameters
         ----------
-        pyramid : ImagePyramid
+        frame : ndarray
             The frame.
-        center : array_like
-            (x, y) window centre, image pixels.
-        size : array_like
-            (w, h) window size, image pixels.
-        angle : float, optional
-            The window's turn, radians.
+        center, size : array_like
+            The predicted window's centre and size (the search region follows the size).
+        angle : float
+            The window's turn (radians).
 
         Returns
         -------
         ndarray
-            (dx, dy), image pixels, from ``center``.
-
-        Raises
-        ------
-        RuntimeError
-            Before :meth:`init`.
+            (2,) displacement, image px.
         """
-        if not self._filter.trained:
-            raise RuntimeError("TranslationFilter.estimate() called before init()")
-        response = np.fft.ifft2(self._filter.response(self._spectrum(pyramid, center, size, angle))).real
-        rows, cols = response.shape
-        cell_px = self._region(size) / [cols, rows]
-        self._response = (response, np.asarray(center, dtype=np.float64), cell_px, angle)
-        r, c = np.unravel_index(int(np.argmax(response)), response.shape)
-        peak = response[r, c]
-        dy = parabola_peak(response[(r - 1) % rows, c], peak, response[(r + 1) % rows, c])
-        dx = parabola_peak(response[r, (c - 1) % cols], peak, response[r, (c + 1) % cols])
-        cells = np.array([(c + cols // 2) % cols - cols // 2 + dx, (r + rows // 2) % rows - rows // 2 + dy])
-        return window_axes(angle) @ (cells * cell_px)
+        scale = self._scale(size)
+        pos = self._position(center, angle)
+        zf = self._spectrum(frame, pos, scale, angle)
+        rf = np.empty(zf.shape[1:], np.complex64)
+        correlate(self.f, zf, rf)
+        resp = sfft.irfft2(rf, s=self.map_hw)
+        dy, dx, value = self.peak(resp, rf)
+        cell_px = features.CELL * scale
+        self._detection = (id(frame), pos, scale, angle, zf)
+        self._response = (resp, pos, cell_px, window_axes(angle))
+        self.confidence = {"peak": value, "apce": apce(resp)}
+        return window_axes(angle) @ (np.array([dx, dy]) * cell_px) + pos - np.asarray(center, dtype=np.float64)
 
     def response_at(self, point) -> float:
-        """The last estimate's response at an image point.
-
-        Parameters
-        ----------
-        point : array_like
-            (x, y) image point.
-
-        Returns
-        -------
-        float
-            The response, bilinear between cells; 0 outside the region.
-
-        Raises
-        ------
-        RuntimeError
-            Before an :meth:`estimate`.
-        """
+        """The last :meth:`estimate`'s response at the window centre ``point`` (image px), interpolated bilinearly
+        between cells (the response is circular over the search region)."""
         if self._response is None:
             raise RuntimeError("TranslationFilter.response_at() needs an estimate() first")
-        response, center, cell_px, angle = self._response
-        rows, cols = response.shape
-        c, r = window_axes(angle).T @ (np.asarray(point, dtype=np.float64) - center) / cell_px
-        c0, r0 = int(np.floor(c)), int(np.floor(r))
-        value = 0.0
-        for rr, wr in ((r0, r0 + 1 - r), (r0 + 1, r - r0)):
-            for cc, wc in ((c0, c0 + 1 - c), (c0 + 1, c - c0)):
-                if abs(rr) <= rows // 2 and abs(cc) <= cols // 2:  # cyclic map: no wrap-around
-                    value += wr * wc * response[rr % rows, cc % cols]
-        return float(value)
+        resp, pos, cell_px, axes = self._response
+        d = axes.T @ (np.asarray(point, dtype=np.float64) - pos) / cell_px
+        return _bilinear_circular(resp, float(d[1]), float(d[0]))
 
-    def update(self, pyramid: ImagePyramid, center, size, angle: float = 0.0) -> None:
-        """Blend in a sample at the tracked window (the running average of DSST eq. 5).
+    # ------------------------------------------------------------------ learning
+    def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
+        """Learn on the window (``center``, ``size``, ``angle``) of ``frame``: the detection sample shifted there
+        when ``frame`` is the one just estimated on at this scale and turn, else a new sample (STRCF, eqs. 3-10)."""
+        scale = self._scale(size)
+        det, self._detection = self._detection, None
+        if det is not None and det[0] == id(frame) and abs(det[2] / scale - 1.0) < 0.05 and det[3] == angle:
+            _, pos, det_scale, _, zf = det
+            shift = window_axes(angle).T @ (np.asarray(center, dtype=np.float64) - pos) / (features.CELL * det_scale)
+            phase_y = np.exp(2j * np.pi * self.ky * shift[1] / self.map_hw[0]).astype(np.complex64)
+            phase_x = np.exp(2j * np.pi * self.kx * shift[0] / self.map_hw[1]).astype(np.complex64)
+            xf = zf * (phase_y[:, None] * phase_x[None, :])[None]
+        else:
+            xf = self._spectrum(frame, self._position(center, angle), scale, angle)
+        self.f = self._admm(xf, self.f)
 
-        Parameters
-        ----------
-        pyramid : ImagePyramid
-            The frame.
-        center : array_like
-            (x, y) window centre, image pixels.
-        size : array_like
-            (w, h) window size, image pixels.
-        angle : float, optional
-            The window's turn, radians.
+    def _admm(self, xf: np.ndarray, f_prev, iterations: int = ADMM_ITERATIONS,
+              gamma: tuple = (GAMMA_INIT, GAMMA_STEP, GAMMA_MAX), mu: float = MU):
+        """STRCF's ADMM (eqs. 5-10) on one sample spectrum ``xf`` (C, rows, cols//2+1), from ``g = h = 0``.
+
+        Per iteration with penalty ``gamma`` (``gamma <- min(step gamma, max)``): the f-step (eq. 8)
+        ``f^ = q + x^ (conj(y^) - x^H q) / (T (gamma + mu) + x^H x^)``, ``q = (gamma g^ - h^ + mu f^_{t-1}) /
+        (gamma + mu)``; the g-step (eq. 9) ``g = (gamma f + h) / (w^2 + gamma)``; the multiplier (eq. 10)
+        ``h^ += gamma (f^ - g^)``.  The last iteration stops after its f-step, so 2 iterations cost one inverse and
+        one forward FFT.  ``mu`` is 0 on the first frame (no previous filter ``f_prev``).
         """
-        self._filter.learn(self._desired, self._spectrum(pyramid, center, size, angle))
+        mu = 0.0 if f_prev is None else mu
+        g_now, g_step, g_max = gamma
+        shape, cdt = xf.shape, xf.dtype
+        rdt = np.float32 if cdt == np.complex64 else np.float64
+        zeros = np.zeros(shape, cdt)
+        S = np.empty(shape[1:], rdt)
+        energy(xf, S)
+        yfc = self.yf_conj.astype(cdt)
+        g = h = None
+        f = np.empty(shape, cdt)
+        xq = np.empty(shape[1:], cdt)
+        for it in range(iterations):
+            kap = g_now + mu
+            dinv = (1.0 / (self.T * kap + S)).astype(rdt)
+            _f_step(xf, yfc, dinv, zeros if g is None else g, zeros if h is None else h,
+                    zeros if f_prev is None else f_prev, rdt(0.0 if g is None else g_now / kap),
+                    rdt(0.0 if h is None else 1.0 / kap), rdt(mu / kap), g is not None or h is not None or mu > 0, f, xq)
+            if it == iterations - 1:
+                break
+            a = g_now * f + (zeros if h is None else h)
+            gs = sfft.irfft2(a, s=self.map_hw) * (1.0 / (self.reg_sq + g_now)).astype(rdt)[None]
+            g = sfft.rfft2(gs).astype(cdt)
+            h = np.zeros(shape, cdt) if h is None else h
+            h += g_now * (f - g)
+            g_now = min(g_step * g_now, g_max)
+        return f
 
-    def _region(self, size) -> np.ndarray:
-        """(w, h) in image pixels of the search region around a window of ``size``: its size times 1 + ``padding``."""
-        return np.asarray(size, dtype=np.float64) * (1.0 + self.padding)
+    # ------------------------------------------------------------------ sampling
+    def _scale(self, size) -> float:
+        """Image px per sample px for a window of ``size``: ``sqrt(w h)`` over the first window's, after
+        resampling (the region keeps its square shape)."""
+        return float(np.sqrt(float(size[0]) * float(size[1]) / float(np.prod(self.base_wh))))
 
-    def _spectrum(self, pyramid: ImagePyramid, center, size, angle: float) -> np.ndarray:
-        """2-D FFT of the tapered (rows, cols, d) features of the search region around the window."""
-        sample = pyramid.sample(center, self._region(size), self.model_size, angle=angle)
-        cols, rows = self.model_size[0] // CELL, self.model_size[1] // CELL
-        features = orientation_histograms(sample[None]).reshape(rows, cols, -1)
-        return np.fft.fft2(features * self._taper, axes=(0, 1))
+    @staticmethod
+    def _position(center, angle: float) -> np.ndarray:
+        """Where the region is centred: the window centre, rounded to a pixel when the region is not turned
+        (STRCF's integer sample position, then the crop is exact)."""
+        c = np.asarray(center, dtype=np.float64)
+        return np.round(c) if angle == 0.0 else c
+
+    def _spectrum(self, frame: np.ndarray, pos, scale: float, angle: float) -> np.ndarray:
+        side = self.support * scale
+        patch = sample_region(frame, pos, (side, side), (self.support, self.support), angle)
+        x = features.extract(patch, self.colour)
+        x *= self.window[None]
+        return sfft.rfft2(x).astype(np.complex64)
+
+
+def _bilinear_circular(resp: np.ndarray, y: float, x: float) -> float:
+    rows, cols = resp.shape
+    y0, x0 = int(np.floor(y)), int(np.floor(x))
+    fy, fx = y - y0, x - x0
+    y0, x0 = y0 % rows, x0 % cols
+    y1, x1 = (y0 + 1) % rows, (x0 + 1) % cols
+    return float((1 - fy) * ((1 - fx) * resp[y0, x0] + fx * resp[y0, x1])
+                 + fy * ((1 - fx) * resp[y1, x0] + fx * resp[y1, x1]))
+
+
+@numba.njit(cache=True, fastmath=True, nogil=True)
+def _f_step(xf, yfc, dinv, g, h, fp, cg, ch, cp, use_q, out, xq):
+    """STRCF's f-step (eq. 8) per frequency: ``q = cg g - ch h + cp fp``, ``f = q + x (conj(y) - x^H q) dinv``."""
+    C, H, W = xf.shape
+    if not use_q:
+        for d in range(C):
+            for i in range(H):
+                for j in range(W):
+                    out[d, i, j] = xf[d, i, j] * (yfc[i, j] * dinv[i, j])
+        return
+    xq[:, :] = 0.0
+    for d in range(C):
+        for i in range(H):
+            for j in range(W):
+                q = cg * g[d, i, j] - ch * h[d, i, j] + cp * fp[d, i, j]
+                out[d, i, j] = q
+                xq[i, j] += np.conj(xf[d, i, j]) * q
+    for i in range(H):
+        for j in range(W):
+            xq[i, j] = (yfc[i, j] - xq[i, j]) * dinv[i, j]
+    for d in range(C):
+        for i in range(H):
+            for j in range(W):
+                out[d, i, j] += xf[d, i, j] * xq[i, j]
