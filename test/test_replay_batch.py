@@ -71,7 +71,8 @@ def test_each_csv_is_the_one_of_its_bag_alone(folder, alone, tmp_path, where, da
     for stem in ("a", "b", "c"):
         assert (out / f"{stem}.csv").read_bytes() == (alone / f"{stem}.csv").read_bytes(), stem
         batch, single = (_raw_messages(p / f"{stem}_result") for p in (out, alone))
-        assert [m[:2] for m in batch] == [m[:2] for m in single] and len(batch) == 2 * N, stem
+        # per image: detections, annotations, debug image, diagnostics (#26)
+        assert [m[:2] for m in batch] == [m[:2] for m in single] and len(batch) == 4 * N, stem
         detections = [m for m in batch if m[0] == DETECTIONS_TOPIC]    # the diagnostics hold wall-clock times
         assert detections == [m for m in single if m[0] == DETECTIONS_TOPIC], stem
     text = capsys.readouterr().out
