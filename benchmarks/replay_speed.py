@@ -16,13 +16,24 @@ time), the share of the wall time spent in the tracker's ``update``, the tracker
 time of everything else in the replay (its own overhead, which alone must allow >= 3x), and frames per
 second of wall time.
 
+With ``--whole N`` it measures instead the whole ``iemd-replay`` process (Python start-up, imports, numba's cache,
+the bag's opening, the replay, the CSV: wall clock from the start of the process to its exit) on the bag with the
+gyro, N runs of each command in turn (A B C A B C ...: the machine's drift hits them alike): this tree, this tree
+with ``--read-ahead 0`` (decoding on the tracker's thread, the serial loop), and with ``--baseline TREE`` another
+checkout of iemd_ros (e.g. a ``git worktree`` of an older commit) run by the same Python; each run's × real time is
+printed, then the medians.  ``--bag`` replays an existing bag instead of making one.
+
     PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py [--frames N] [--no-gyro-too] [--compress C ...]
                                                              [--keep DIR]
+    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py --whole 5 [--bag BAG] [--baseline TREE]
 """
 from __future__ import annotations
 
 import argparse
+import os
 import shutil
+import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -55,6 +66,51 @@ def io_only(bag: Path) -> tuple[float, int]:
         reader.close()
 
 
+ROOT = Path(__file__).resolve().parents[1]
+INIT = "281,284,42.1,51"   # the desk sequence's first ground-truth box, as the README replays it
+
+
+def _replay_command(tree: Path) -> list[str]:
+    """``python -m`` the iemd-replay of the checkout ``tree`` (apps/replay.py since the packages; replay.py before)."""
+    module = "iemd_ros.apps.replay" if (tree / "iemd_ros" / "apps" / "replay.py").is_file() else "iemd_ros.replay"
+    return [sys.executable, "-m", module]
+
+
+def whole_runs(bag: Path, runs: int, baseline: Path | None, folder: Path) -> None:
+    """``runs`` interleaved whole-process runs of iemd-replay on ``bag``; prints each and the medians."""
+    commands = {"this tree": (ROOT, []), "this tree, --read-ahead 0": (ROOT, ["--read-ahead", "0"])}
+    if baseline is not None:
+        commands[f"{baseline}"] = (baseline.resolve(), [])
+    duration = None
+    walls: dict[str, list[float]] = {k: [] for k in commands}
+    for i in range(runs + 1):                    # run 0 warms the page cache and numba's cache: not counted
+        for label, (tree, extra) in commands.items():
+            csv_path = folder / f"whole_{len(walls[label])}_{abs(hash(label))}.csv"
+            cmd = _replay_command(tree) + [str(bag), "--init", INIT, "--csv", str(csv_path), "--no-progress", *extra]
+            env = dict(os.environ, PYTHONPATH=str(tree))
+            t0 = time.perf_counter()
+            done = subprocess.run(cmd, env=env, cwd=tree, capture_output=True, text=True)  # -m: cwd first
+            wall = time.perf_counter() - t0
+            if done.returncode != 0:
+                raise SystemExit(f"replay_speed: {' '.join(cmd)} failed:\n{done.stderr}")
+            if duration is None:
+                duration = _csv_duration(csv_path)
+            if i > 0:
+                walls[label].append(wall)
+                print(f"run {i} {label:<40} {wall:7.2f} s wall  {duration / wall:5.2f}x real time", flush=True)
+    print(f"\nbag duration (images): {duration:.2f} s; whole process, wall clock incl. start-up, {runs} runs each:")
+    for label, w in walls.items():
+        print(f"  {label:<40} median {statistics.median(w):6.2f} s = {duration / statistics.median(w):5.2f}x real "
+              f"time (runs: {', '.join(f'{duration / x:.2f}' for x in w)})")
+
+
+def _csv_duration(path: Path) -> float:
+    """Bag time spanned by a replay CSV's images, as ``ReplayResult.duration_s`` counts it."""
+    import numpy as np
+    stamps = np.array([int(line.split(",", 1)[0]) for line in path.read_text().splitlines()[1:]], dtype=np.int64)
+    return float(stamps[-1] - stamps[0] + np.median(np.diff(stamps))) * 1e-9
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--desk", type=Path, default=DESK, help="cmu_hwangbo_desk folder")
@@ -63,7 +119,18 @@ def main() -> int:
     ap.add_argument("--compress", nargs="+", choices=COMPRESSED_CODECS, default=[],
                     help="also replay the frames as CompressedImage bags of these codecs")
     ap.add_argument("--keep", type=Path, default=None, help="write the bags into this folder and keep them")
+    ap.add_argument("--whole", type=int, default=0, metavar="N",
+                    help="N interleaved runs of the whole iemd-replay process (see above) instead")
+    ap.add_argument("--bag", type=Path, default=None, help="with --whole: replay this bag instead of making one")
+    ap.add_argument("--baseline", type=Path, default=None, help="with --whole: also run this checkout's iemd-replay")
     a = ap.parse_args()
+    if a.whole > 0 and a.bag is not None:
+        folder = Path(tempfile.mkdtemp(prefix="iemd_replay_speed_"))
+        try:
+            whole_runs(a.bag.resolve(), a.whole, a.baseline, folder)
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+        return 0
     if not a.desk.is_dir():
         print(f"replay_speed: the desk recording is not at {a.desk}", file=sys.stderr)
         return 2
@@ -78,6 +145,9 @@ def main() -> int:
             print(f"bag: {info['frames']} images {info['size'][0]}x{info['size'][1]} bgr8 {codec or 'raw'} + "
                   f"{info['imu']} IMU samples -> {bag} (made in {time.perf_counter() - t0:.1f} s)")
         init = tuple(float(v) for v in src.gt_boxes[0])
+        if a.whole > 0:
+            whole_runs(bags["raw"], a.whole, a.baseline, folder)
+            return 0
         runs = [("raw", "gyro", True)] + ([("raw", "no-gyro", False)] if a.no_gyro_too else []) + \
                [(codec, "gyro", True) for codec in a.compress]
         io = {kind: io_only(bag) for kind, bag in bags.items()}

@@ -71,3 +71,20 @@ def stop_process():
             return out, err, False
 
     return stop
+
+
+@pytest.fixture(scope="session")
+def dask_cluster() -> str:
+    """The address of a Dask distributed cluster on this machine only: a scheduler and 2 single-thread worker
+    processes on 127.0.0.1, started here and closed at the end of the session.  Every port is a free one on the
+    loopback (the scheduler's HTTP server listens even without a dashboard: on 127.0.0.1 too).  The workers are
+    started as the README advises (DASK_WORKER_CONFIG); Dask's one-thread numpy settings stay."""
+    import dask
+    from distributed import LocalCluster
+
+    from iemd_ros.common.parallel import DASK_WORKER_CONFIG
+
+    with dask.config.set(DASK_WORKER_CONFIG), LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", scheduler_port=0,
+            dashboard_address="127.0.0.1:0", memory_limit="4GiB") as cluster:
+        yield cluster.scheduler_address

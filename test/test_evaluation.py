@@ -10,7 +10,7 @@ from helpers import PNG_SIGNATURE, cli_error, node_parameter_file, run_module
 from iemd_ros import TrackerConfig
 from iemd_ros.evaluation import ope as evaluation
 from iemd_ros.apps.eval import main
-from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
+from iemd_ros.evaluation.ope import WALL_CLOCK_FIELDS, make_tracker, results_digest, run_tracker, sequence_names
 from iemd_ros.datasets.otb import load_sequence
 
 # Measured on Car4 frames 1-20 (OpenCV 5.0.0 contrib): CSRT average overlap 85.8 %, KCF 87.9 %.
@@ -46,7 +46,7 @@ def test_protocol_with_oracle_tracker(tmp_path, monkeypatch, capsys):
     _Oracle.gt = gt
     monkeypatch.setitem(evaluation.TRACKERS, "oracle", _Oracle)
     out = tmp_path / "out"
-    assert main([str(root), "--trackers", "oracle", "--out", str(out), "--max-frames", "5"]) == 0
+    assert main([str(root), "--trackers", "oracle", "--out", str(out), "--max-frames", "5", "--jobs", "1"]) == 0
     doc = json.loads((out / "results.json").read_text())
     res = doc["results"]["oracle"]["Toy"]
     np.testing.assert_array_equal(res["boxes"], gt[:5])  # frame/GT alignment, first frame = GT
@@ -137,6 +137,8 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
     [
         (["--trackers", "nope"], "unknown tracker 'nope'"),
         (["--max-frames", "zero", "--trackers", "kcf"], "not an integer"),
+        (["--jobs", "0", "--trackers", "kcf"], "--jobs must be >= 1, got 0"),
+        (["--jobs", "2", "--cluster", "tcp://127.0.0.1:9", "--trackers", "kcf"], "not allowed with"),
         (["--max-frames", "1", "--trackers", "kcf"], "must be >= 2"),
         (["--bogus"], "unrecognized arguments"),
         (["/no/such/dir", "--trackers", "kcf"], "neither an OTB root nor a sequence folder"),
@@ -186,7 +188,7 @@ def test_group_means_and_published_ranking(tmp_path, monkeypatch, capsys):
     path.write_text(json.dumps(published))
     out = tmp_path / "out"
     assert main([str(root_a), str(root_b), "--trackers", "oracle", "--out", str(out), "--max-frames", "5",
-                 "--published", str(path)]) == 0
+                 "--published", str(path), "--jobs", "1"]) == 0      # the oracle is known to this process only
     doc = json.loads((out / "results.json").read_text())
     means = {k for k in doc["results"]["oracle"] if k.startswith("mean")}
     assert means == {"mean", "mean data", "mean other"} and doc["groups"] == {"Toy": "data", "Toy2": "other"}
@@ -219,3 +221,57 @@ def test_the_split_is_the_hash_rule_over_the_shared_sequences(otb_root):
     assert not set(split_names("train")) & set(split_names("validation"))
     with pytest.raises(ValueError, match="unknown split part 'test'"):
         split_names("test")
+
+
+def _without_wall_clock(doc: dict) -> dict:
+    return {**doc, "results": {t: {k: {f: v for f, v in e.items() if f not in WALL_CLOCK_FIELDS} for k, e in r.items()}
+                               for t, r in doc["results"].items()}}
+
+
+def test_results_are_the_serial_ones_on_local_processes_and_on_a_cluster(otb_root, tmp_path, dask_cluster, capsys):
+    """The same jobs in this process, on 2 local processes and on the test's Dask cluster: the same results.json
+    (keys, order, numbers) but for the wall-clock fields, the same digest, the same plots.  CSRT and KCF are in:
+    OpenCV's trackers are deterministic too."""
+    common = [str(otb_root), "--trackers", "iemd,csrt,kcf", "--sequences", "Deer,Skiing", "--max-frames", "12"]
+    runs = {"serial": ["--jobs", "1"], "local": ["--jobs", "2"], "cluster": ["--cluster", dask_cluster]}
+    docs, texts = {}, {}
+    for name, where in runs.items():
+        assert main(common + where + ["--out", str(tmp_path / name)]) == 0
+        texts[name] = (tmp_path / name / "results.json").read_text()
+        docs[name] = json.loads(texts[name])
+        assert capsys.readouterr().out.rstrip().endswith(results_digest(docs[name]))   # the digest it prints
+    serial = docs["serial"]
+    assert len(serial["results"]["iemd"]["Deer"]["boxes"]) == 12 and results_digest(serial) != results_digest(
+        {**serial, "sequences": serial["sequences"][::-1]})                             # order counts
+    for name in ("local", "cluster"):
+        assert results_digest(docs[name]) == results_digest(serial), name
+        assert json.dumps(_without_wall_clock(docs[name])) == json.dumps(_without_wall_clock(serial))
+        for png in ("success_Deer.png", "success_Skiing.png", "success_overall.png"):
+            assert (tmp_path / name / png).read_bytes() == (tmp_path / "serial" / png).read_bytes(), (name, png)
+
+
+def test_the_digest_leaves_out_the_wall_clock_fields_only(tmp_path, monkeypatch):
+    root, gt = _synthetic_root(tmp_path)
+    _Oracle.gt = gt
+    monkeypatch.setitem(evaluation.TRACKERS, "oracle", _Oracle)
+    assert main([str(root), "--trackers", "oracle", "--out", str(tmp_path / "out"), "--jobs", "1"]) == 0
+    doc = json.loads((tmp_path / "out" / "results.json").read_text())
+    entry = doc["results"]["oracle"]["Toy"]
+    assert set(WALL_CLOCK_FIELDS) <= entry.keys()
+    digest = results_digest(doc)
+    for field in WALL_CLOCK_FIELDS:
+        changed = json.loads(json.dumps(doc))
+        changed["results"]["oracle"]["Toy"][field] = 12345.0
+        assert results_digest(changed) == digest, field
+    changed = json.loads(json.dumps(doc))
+    changed["results"]["oracle"]["Toy"]["boxes"][1][0] += 1e-9
+    assert results_digest(changed) != digest
+
+
+def test_unreachable_cluster_exits_2_one_line(otb_root, capsys, monkeypatch):
+    import dask
+
+    with dask.config.set({"distributed.comm.timeouts.connect": "2s"}):
+        err = cli_error(main, [str(otb_root), "--trackers", "kcf", "--sequences", "Deer", "--max-frames", "3",
+                               "--cluster", "tcp://127.0.0.1:9"], capsys, "iemd-eval: error:")
+    assert "127.0.0.1:9" in err

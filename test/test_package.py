@@ -11,8 +11,9 @@ from helpers import REPO
 ROSDEP_KEYS = {"cv2": "python3-opencv", "numpy": "python3-numpy", "yaml": "python3-yaml",
                "matplotlib": "python3-matplotlib", "scipy": "python3-scipy", "numba": "python3-numba",
                "rosbags": "python3-rosbags-pip"}
-# Top-level module -> its PyPI distribution (no rosdep key for Jazzy's platforms).
-PIP_ONLY = {"ot": "POT"}
+# Top-level module -> its PyPI distribution (no rosdep key for Jazzy's platforms; distributed is imported only by
+# --cluster, iemd_ros.common.parallel).
+PIP_ONLY = {"ot": "POT", "distributed": "distributed"}
 
 
 def _imported_modules() -> set[str]:

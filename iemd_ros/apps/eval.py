@@ -2,6 +2,7 @@
 
     iemd-eval [ROOT_OR_SEQ ...] [--trackers iemd,csrt,kcf] [--sequences Car4,Bolt2] [--split train|validation]
               [--max-frames N] [--out DIR] [--config config/tracker.yaml] [--published [FILE]]
+              [--jobs N | --cluster tcp://HOST:8786]
 
 Without a folder it evaluates every sequence of ``../shared/data/otb`` and ``../shared/data/uav``.  Prints the
 average overlap, success AUC, precision at 20 px and fps per sequence and on average, and writes
@@ -9,6 +10,12 @@ average overlap, success AUC, precision at 20 px and fps per sequence and on ave
 on stderr and exits with status 2.  ``--split`` keeps the training or the validation part of the fixed split
 (:mod:`iemd_ros.evaluation.split`); ``--published`` ranks the run among the published trackers on the same sequences
 (:mod:`iemd_ros.evaluation.published`).
+
+Each tracker on each sequence is one job; the jobs run on every local core by default (``--jobs``), or on a Dask
+distributed cluster (``--cluster``), with a progress bar on stderr when it is a terminal
+(:mod:`iemd_ros.common.parallel`).  ``results.json`` is the same whichever workers ran the jobs, but for its
+wall-clock fields (fps, timings): the last line prints its digest without them
+(:func:`iemd_ros.evaluation.ope.results_digest`).
 """
 from __future__ import annotations
 
@@ -18,8 +25,9 @@ import time
 from pathlib import Path
 
 from iemd_ros.common.cli import CliParser, cli_main
-from iemd_ros.evaluation.ope import (DEFAULT_OUT, DEFAULT_TRACKERS, TRACKERS, collect_sequences, evaluate,
-                                     format_long_term, format_table, make_tracker)
+from iemd_ros.common.parallel import Workers, add_worker_arguments
+from iemd_ros.evaluation.ope import (DEFAULT_OUT, DEFAULT_TRACKERS, TRACKERS, WALL_CLOCK_FIELDS, collect_sequences,
+                                     evaluate, format_long_term, format_table, make_tracker, results_digest)
 from iemd_ros.evaluation.published import default_published, format_published, load_published
 from iemd_ros.evaluation.split import PARTS, split_names
 from iemd_ros.pipeline import PipelineConfig
@@ -66,6 +74,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--published", nargs="?", type=Path, const=PUBLISHED_DEFAULT, default=None, metavar="FILE",
                    help="print the published trackers' results on the same sequences beside the run "
                         "(default file: ../shared/anchors/published_results.json)")
+    add_worker_arguments(p)
     return p
 
 
@@ -93,10 +102,14 @@ def main(argv: list[str] | None = None) -> int:
         sequences = collect_sequences(args.inputs, wanted)
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
+        workers = Workers.from_args(args)
+        n_jobs = len(trackers) * len(sequences)
         t_start = time.perf_counter()
-        print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) -> {args.out}"
+        print(f"iemd-eval: {len(trackers)} tracker(s) x {len(sequences)} sequence(s) = {n_jobs} jobs "
+              f"{workers.describe(n_jobs)} -> {args.out}"
               + (f" (iEMD parameters from {args.config})" if args.config else ""))
-        doc = evaluate(sequences, trackers, args.out, configs=configs)  # unreadable image, unwritable --out: one line, exit 2
+        # unreadable image, unwritable --out, unreachable cluster: one line, exit 2
+        doc = evaluate(sequences, trackers, args.out, configs=configs, workers=workers)
         print()
         print(format_table(doc["results"], trackers, doc["sequences"]))
         long_term = format_long_term(doc)
@@ -109,7 +122,8 @@ def main(argv: list[str] | None = None) -> int:
             if args.max_frames is not None:
                 print(f"(this run scored the first {args.max_frames} frames only; the published figures are over "
                       "whole sequences)")
-        print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}")
+        print(f"\nwall time {time.perf_counter() - t_start:.1f} s; results in {args.out / 'results.json'}, "
+              f"digest without {', '.join(WALL_CLOCK_FIELDS)}: {results_digest(doc)}")
         return 0
 
     return cli_main("iemd-eval", body)

@@ -11,7 +11,8 @@ import argparse
 import sys
 from pathlib import Path
 
-from iemd_ros.bags.io import FORMATS, Progress
+from iemd_ros.bags.io import FORMATS
+from iemd_ros.common.progress import Progress
 from iemd_ros.bags.make import CAMERA_FRAME, DEFAULT_TOPICS, ENCODINGS, IMU_FRAME, source_from_folder, write_bag
 from iemd_ros.common.cli import CliParser, cli_main
 from iemd_ros.messages.conversions import COMPRESSED_CODECS, JPEG_QUALITY

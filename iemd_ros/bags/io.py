@@ -20,7 +20,6 @@
 from __future__ import annotations
 
 import shutil
-import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,7 +30,7 @@ from iemd_ros.messages.conversions import ns_to_stamp, raw_twin
 from iemd_ros.common.cli import one_line
 
 __all__ = ["IMAGE_TYPE", "COMPRESSED_IMAGE_TYPE", "IMAGE_TYPES", "IMU_TYPE", "CAMERA_INFO_TYPE", "FORMATS",
-           "BagError", "BagMessages", "BagWriter", "Progress", "Topics", "camera_info_fields", "custom_data", "deserialize",
+           "BagError", "BagMessages", "BagWriter", "Topics", "bag_path", "camera_info_fields", "custom_data", "deserialize",
            "header", "iter_messages", "open_bag", "resolve_bag_path", "ros1_typestore", "ros2_typestore",
            "salvage_mcap", "Salvage", "select_topics"]
 
@@ -319,6 +318,29 @@ def resolve_bag_path(path) -> Path:
     if p.is_dir() and not (p / "metadata.yaml").is_file():
         raise BagError(f"{p} is not a rosbag2 folder: it has no metadata.yaml")
     return p
+
+
+def bag_path(path) -> Path:
+    """The bag a path names, as :func:`open_bag` reads it: a lone mcap (a bare ``.mcap`` file, or a folder holding one
+    without ``metadata.yaml``) as given, else :func:`resolve_bag_path`'s path.
+
+    Parameters
+    ----------
+    path : str or path-like
+        What :func:`open_bag` takes.
+
+    Returns
+    -------
+    Path
+        The bag.
+
+    Raises
+    ------
+    BagError
+        As :func:`resolve_bag_path`.
+    """
+    p = Path(path)
+    return p if p.exists() and _lone_mcap(p) is not None else resolve_bag_path(p)
 
 
 def _lone_mcap(path: Path) -> Path | None:
@@ -710,51 +732,3 @@ def custom_data(reader) -> dict:
         md = getattr(getattr(r, "storage", None), "metadata", None)
         out.update(getattr(md, "custom", None) or {})
     return out
-
-
-class Progress:
-    """A one-line progress bar on stderr (only when stderr is a terminal; ``enabled`` overrides).
-
-    Parameters
-    ----------
-    total : int
-        Number of steps (0: no bar).
-    label : str, optional
-        Text before the bar.
-    enabled : bool, optional
-        Show the bar (default: when the stream is a terminal).
-    stream : file, optional
-        Where the bar goes (default ``sys.stderr``).
-    """
-
-    def __init__(self, total: int, label: str = "", enabled: bool | None = None, stream=None):
-        self.stream = stream if stream is not None else sys.stderr
-        self.enabled = (self.stream.isatty() if enabled is None else enabled) and total > 0
-        self.total, self.label, self.n, self._last = int(total), label, 0, -1
-
-    def update(self, n: int = 1, note: str = "") -> None:
-        """Advance the bar.
-
-        Parameters
-        ----------
-        n : int, optional
-            Steps done.
-        note : str, optional
-            Text after the bar.
-        """
-        self.n += n
-        if not self.enabled:
-            return
-        pct = int(100 * self.n / self.total)
-        if pct == self._last and self.n < self.total:
-            return
-        self._last = pct
-        filled = int(30 * self.n / self.total)
-        self.stream.write(f"\r{self.label} [{'#' * filled}{'.' * (30 - filled)}] {self.n}/{self.total} {note}")
-        self.stream.flush()
-
-    def close(self) -> None:
-        """End the bar's line."""
-        if self.enabled:
-            self.stream.write("\n")
-            self.stream.flush()

@@ -7,7 +7,9 @@ paper's table metric, OTB success AUC, precision@20px, overlap > 0 / > 0.4).  Th
 the plain mean of the per-sequence figures (OTB averages the per-sequence success curves), fps included.
 
 Speed: only the ``init``/``update`` calls are timed (image decoding is not); fps = frames / (init time +
-sum of update times), sequences and trackers run one after the other in this process.
+sum of update times).  A job is one tracker on one sequence, run in one process; the jobs run one after the
+other (``--jobs 1``) or at the same time on several workers, where they share the cores: fps and the other
+:data:`WALL_CLOCK_FIELDS` are those of the run that measured them, and :func:`results_digest` leaves them out.
 
 Tracker failures: OTB has no notion of failure, every tracker reports its current estimate on every
 frame.  Each frame is scored with the box the tracker returns; when that box is empty/invalid (OpenCV's
@@ -20,6 +22,7 @@ model, and resume from that position (test_evaluation checks it for KCF).  The r
 """
 from __future__ import annotations
 
+import hashlib
 import json
 import time
 from dataclasses import dataclass
@@ -29,6 +32,7 @@ from typing import Callable, Protocol
 import cv2
 import numpy as np
 
+from iemd_ros.common.parallel import Workers, run_jobs
 from iemd_ros.evaluation.metrics import (OTB_THRESHOLDS, PRECISION_THRESHOLD, SequenceScores, long_term_scores,
                                          score_sequence, valid_boxes)
 from iemd_ros.datasets.otb import Sequence, default_roots, is_sequence_folder, list_sequences, load_sequence
@@ -37,6 +41,8 @@ from iemd_ros.tracking import IemdTracker, TrackerConfig
 DEFAULT_TRACKERS = ("iemd", "csrt", "kcf")
 DEFAULT_OUT = Path("out") / "eval"
 MEAN = "mean"
+#: the fields of a run's entry (and of a mean) in ``results.json`` that are wall-clock measurements
+WALL_CLOCK_FIELDS = ("fps", "init_ms", "update_ms_median", "update_ms_p95")
 
 
 class TrackerAdapter(Protocol):
@@ -303,6 +309,55 @@ def evaluate_sequence(seq: Sequence, tracker: TrackerAdapter) -> tuple[SequenceS
     return score_sequence(run.boxes, seq.gt_boxes, seq.name, fps=run.fps), run
 
 
+@dataclass(frozen=True)
+class EvalJob:
+    """One job of :func:`evaluate`: a tracker on a sequence.
+
+    Parameters
+    ----------
+    sequence : Sequence
+        The sequence (its frames are read by the job).
+    tracker : str
+        A name in :data:`TRACKERS`.
+    config : optional
+        The tracker's configuration (None: its defaults).
+    """
+
+    sequence: Sequence
+    tracker: str
+    config: object = None
+
+
+def run_job(job: EvalJob) -> tuple[SequenceScores, dict]:
+    """Run a fresh tracker of ``job`` on its sequence: the scores and the sequence's entry of ``results.json``.
+
+    Parameters
+    ----------
+    job : EvalJob
+        The tracker and the sequence.
+
+    Returns
+    -------
+    scores : SequenceScores
+        The run's figures, fps included.
+    entry : dict
+        The figures, the failures, the timings, the boxes and the ok flags.
+    """
+    scores, run = evaluate_sequence(job.sequence, make_tracker(job.tracker, job.config))
+    entry = scores.to_dict()
+    entry.update(
+        failures=int((~run.ok).sum()),
+        init_ms=1e3 * run.init_seconds,
+        update_ms_median=1e3 * float(np.median(run.update_seconds)) if run.update_seconds.size else None,
+        update_ms_p95=1e3 * float(np.percentile(run.update_seconds, 95)) if run.update_seconds.size else None,
+        boxes=run.boxes.tolist(),
+        ok=run.ok.tolist(),
+    )
+    if not valid_boxes(job.sequence.gt_boxes).all():  # the target leaves the view: VOT's long-term measures too
+        entry["long_term"] = long_term_scores(run.boxes, run.ok, job.sequence.gt_boxes).to_dict()
+    return scores, entry
+
+
 def mean_scores(scores: list[SequenceScores]) -> dict:
     """Mean over sequences of every per-sequence figure (OTB's overall plot averages the curves).
 
@@ -527,10 +582,15 @@ def sequence_names(wanted: str | None) -> list[str]:
     return list(_select_targets([], wanted.split(",") if wanted else None))
 
 
-def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, configs=None) -> dict:
+def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=print, configs=None,
+             workers: Workers = Workers(1), progress: bool | None = None) -> dict:
     """Run every tracker on every sequence, write ``results.json`` and success plots into ``out``.
 
-    The iEMD configuration is recorded in ``results.json`` when iEMD runs.
+    Each (sequence, tracker) pair is one :class:`EvalJob` of :func:`run_job`, run by ``workers``
+    (:func:`iemd_ros.common.parallel.run_jobs`); the document is built from the jobs' results in the order
+    of the sequences and trackers, so it is the same on any workers but for its wall-clock fields
+    (:data:`WALL_CLOCK_FIELDS`, :func:`results_digest`).  The iEMD configuration is recorded in
+    ``results.json`` when iEMD runs.
 
     Parameters
     ----------
@@ -541,9 +601,13 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
     out : Path
         The output folder, created if needed.
     log : callable, optional
-        Receives one line per sequence and tracker.
+        Receives one line per sequence and tracker, in the order the jobs finish.
     configs : dict, optional
         Tracker name -> its configuration (:func:`make_tracker`; absent: the defaults).
+    workers : Workers, optional
+        Where the jobs run (default: in this process, one after the other).
+    progress : bool, optional
+        Show a progress bar over the jobs on stderr (default: when stderr is a terminal).
 
     Returns
     -------
@@ -552,26 +616,20 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
     """
     configs = configs or {}
     out.mkdir(parents=True, exist_ok=True)
+    jobs = [EvalJob(seq, trk, configs.get(trk)) for seq in sequences for trk in trackers]
+
+    def report(index: int, done: tuple[SequenceScores, dict]) -> str:
+        scores, job = done[0], jobs[index]
+        return (f"  {job.sequence.name:<14} {job.tracker:<5} AO {_pct(scores.average_overlap)}%  "
+                f"AUC {_pct(scores.success_auc)}%  P@20 {_pct(scores.precision_20)}%  {scores.fps:7.1f} fps")
+
+    outcomes = run_jobs(run_job, jobs, workers, label="iemd-eval", progress=progress, report=report, log=log)
     results: dict[str, dict] = {t: {} for t in trackers}
     per_seq_scores: dict[str, list[SequenceScores]] = {t: [] for t in trackers}
+    for job, (scores, entry) in zip(jobs, outcomes):
+        per_seq_scores[job.tracker].append(scores)
+        results[job.tracker][job.sequence.name] = entry
     for seq in sequences:
-        for trk in trackers:
-            scores, run = evaluate_sequence(seq, make_tracker(trk, configs.get(trk)))
-            per_seq_scores[trk].append(scores)
-            entry = scores.to_dict()
-            entry.update(
-                failures=int((~run.ok).sum()),
-                init_ms=1e3 * run.init_seconds,
-                update_ms_median=1e3 * float(np.median(run.update_seconds)) if run.update_seconds.size else None,
-                update_ms_p95=1e3 * float(np.percentile(run.update_seconds, 95)) if run.update_seconds.size else None,
-                boxes=run.boxes.tolist(),
-                ok=run.ok.tolist(),
-            )
-            if not valid_boxes(seq.gt_boxes).all():  # the target leaves the view: VOT's long-term measures too
-                entry["long_term"] = long_term_scores(run.boxes, run.ok, seq.gt_boxes).to_dict()
-            results[trk][seq.name] = entry
-            log(f"  {seq.name:<14} {trk:<5} AO {_pct(scores.average_overlap)}%  "
-                f"AUC {_pct(scores.success_auc)}%  P@20 {_pct(scores.precision_20)}%  {scores.fps:7.1f} fps")
         plot_success({t: results[t][seq.name]["success_curve"] for t in trackers},
                      f"Success plot of OPE - {seq.name}", out / f"success_{seq.name}.png")
     for trk in trackers:
@@ -603,8 +661,34 @@ def evaluate(sequences: list[Sequence], trackers: list[str], out: Path, log=prin
         "frame_numbers": {s.name: list(s.frame_numbers) for s in sequences},
         "results": results,
     }
-    (out / "results.json").write_text(json.dumps(doc, indent=1, allow_nan=False, default=_json_default))
+    (out / "results.json").write_text(_dumps(doc))
     return doc
+
+
+def results_digest(doc: dict) -> str:
+    """SHA-256 of a results document as ``results.json`` holds it, less the wall-clock fields of its results.
+
+    Everything else a run writes is computed from the frames by deterministic trackers, so two runs of the
+    same trackers on the same sequences have the same digest, whichever workers ran them.
+
+    Parameters
+    ----------
+    doc : dict
+        The document :func:`evaluate` returns, or ``results.json`` read back.
+
+    Returns
+    -------
+    str
+        The hexadecimal digest.
+    """
+    results = {trk: {key: {k: v for k, v in entry.items() if k not in WALL_CLOCK_FIELDS}
+                     for key, entry in per_sequence.items()}
+               for trk, per_sequence in doc["results"].items()}
+    return hashlib.sha256(_dumps({**doc, "results": results}).encode()).hexdigest()
+
+
+def _dumps(doc: dict) -> str:
+    return json.dumps(doc, indent=1, allow_nan=False, default=_json_default)
 
 
 def _json_default(obj):

@@ -21,7 +21,8 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from iemd_ros.bags.io import BagError, Progress, iter_messages, open_bag, ros2_typestore
+from iemd_ros.bags.io import BagError, iter_messages, open_bag, ros2_typestore
+from iemd_ros.common.progress import Progress
 from iemd_ros.messages.conversions import ns_to_stamp
 from iemd_ros.ros.messages import message_class
 
