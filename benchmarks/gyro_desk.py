@@ -3,9 +3,8 @@ the gyro prior on the CMU desk sequence (eagle-head ground truth, gt_eagle_head.
 
 The tracker is initialised on the first frame whose GT flag is ``ok`` and run causally over the
 raw (distorted) frames; the gyro prior for frame k is the lens-aware local homography at the
-tracker's current window (``GyroPredictor.predict``), integrated from the frame the window belongs
-to (after a frame reported lost, the tracker keeps its previous window, so the rotation is
-integrated from that frame).  Scores (iemd_ros.evaluation.metrics) over the first 100 frames (the paper's
+tracker's current window (``GyroPredictor.predict``), integrated from the previous frame (the
+node's pipeline: a lost window keeps moving with the camera).  Scores (iemd_ros.evaluation.metrics) over the first 100 frames (the paper's
 sequence length) and over the whole sequence, from the init frame on (the init frame included, as
 in OTB); frames whose GT is absent are excluded (the desk GT has none).  Both modes use the
 tracker's scale estimator (``--scale-estimator``); with the paper's EMD scale variants, the ±10 %

@@ -305,3 +305,28 @@ def test_imu_wakes_the_worker_only_for_the_frame_it_holds(ctx, seq):
         assert wakes == [1]                                   # frame 1 covered: wake the worker
     finally:
         node.destroy_node()
+
+
+def test_a_lost_target_gets_empty_detections_a_lost_flag_and_a_diagnostic(ctx, seq):
+    """Tracked on frames 0-2, then frames of noise (the target is gone): each is answered with an empty
+    Detection2DArray, ``~/lost`` (false while tracked) reads true and the tracking status says for how long."""
+    from std_msgs.msg import Bool
+    s = [int(v) for v in seq.frame_stamps_ns]
+    lost_flags = []
+    with tracker_and_driver(ctx, initial_box=[float(v) for v in seq.gt_boxes[0]], imu_wait_ms=100.0) as (node, drv):
+        drv.node.create_subscription(Bool, "/iemd_tracker/lost", lambda m: drv._record(lost_flags, m.data), 100)
+        drv.publish_camera_info(seq)
+        sent = 0
+        for k in range(3):
+            sent = drv.publish_imu_until(seq, s[k], sent)
+            drv.publish_image(seq.frames[k], s[k])
+            assert drv.wait_for(lambda k=k: any(stamp_ns(d.header) == s[k] for d in drv.detections), 10.0)
+        assert drv.detections[-1].detections and lost_flags and lost_flags[-1] is False
+        noise = np.random.default_rng(5).integers(0, 256, seq.frames[3].shape, dtype=np.uint8)
+        for k in range(3, 9):
+            sent = drv.publish_imu_until(seq, s[k], sent)
+            drv.publish_image(noise, s[k])
+            assert drv.wait_for(lambda k=k: any(stamp_ns(d.header) == s[k] for d in drv.detections), 10.0)
+        assert not drv.detections[-1].detections and lost_flags[-1] is True
+        trk = drv.wait_status("tracking", lambda st: "target lost for" in st.message, 5.0)
+        assert trk is not None and level(trk) == WARN and float(values(trk)["lost_s"]) > 0, trk

@@ -14,8 +14,8 @@ def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True
 
     The frames and the whole gyro record go through a :class:`~iemd_ros.pipeline.pipeline.TrackingPipeline`, so the
     priors are the node's: with ``use_gyro`` the prior for frame k is the lens-aware local homography at the tracker's
-    window, integrated from the frame that window belongs to (after a frame reported lost the tracker keeps its previous
-    window), and a prior the tracker refuses is dropped for that frame.
+    window, integrated from the previous frame (lost or not: a lost window keeps moving with the camera), and a prior
+    the tracker refuses is dropped for that frame.
 
     Parameters
     ----------

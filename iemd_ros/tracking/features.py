@@ -61,9 +61,9 @@ def _atan2_pos(y, x):
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
-def _grad_bins(img, cell, O0, M0, M1, soft):
-    """Per pixel: the lower orientation bin ``O0`` and the two interpolated votes ``M0, M1`` (magnitude / cell^2)
-    of the colour channel of largest gradient (centred differences, one-sided at the border)."""
+def _grad_bins(img, cell, O0, M0):
+    """Per pixel: the nearest of 18 orientation bins ``O0`` and the vote ``M0`` (magnitude / cell^2) of the colour
+    channel of largest gradient (centred differences, one-sided at the border)."""
     H, W, C = img.shape
     norm = 1.0 / (cell * cell)
     omult = 18.0 / (2.0 * math.pi)
@@ -88,22 +88,16 @@ def _grad_bins(img, cell, O0, M0, M1, soft):
                     gyb = gy
             m = math.sqrt(best)
             o = _atan2_pos(gyb, gxb) * omult
-            if soft:
-                o0 = int(o)
-                od = o - o0
-            else:  # nearest bin
-                o0 = int(o + 0.5)
-                od = 0.0
+            o0 = int(o + 0.5)
             if o0 >= 18:
                 o0 -= 18
             O0[y, x] = o0
-            M1[y, x] = od * m * norm
-            M0[y, x] = m * norm - od * m * norm
+            M0[y, x] = m * norm
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
-def _accumulate(O0, M0, M1, cell, R, soft):
-    """Spatially bilinear votes into the 4 nearest cells (x the 2 nearest orientation bins when ``soft``).
+def _accumulate(O0, M0, cell, R):
+    """Spatially bilinear votes into the 4 nearest cells.
     ``R`` is (hb + 2, wb + 2, 18), one cell of padding each side catching the votes that fall outside the
     map.  (Direct 3-D indexing: keeping row views in variables costs numba reference counting.)"""
     H, W = O0.shape
@@ -124,37 +118,19 @@ def _accumulate(O0, M0, M1, cell, R, soft):
             R[yb0 + 1, xb0 + 2, o0] += (1.0 - yd) * xd * m0
             R[yb0 + 2, xb0 + 1, o0] += yd * (1.0 - xd) * m0
             R[yb0 + 2, xb0 + 2, o0] += yd * xd * m0
-    if soft:
-        for y in range(hb * cell):
-            yb = (y + 0.5) * inv - 0.5
-            yb0 = int(math.floor(yb))
-            yd = yb - yb0
-            for x in range(wb * cell):
-                xb = (x + 0.5) * inv - 0.5
-                xb0 = int(math.floor(xb))
-                xd = xb - xb0
-                o1 = O0[y, x] + 1
-                if o1 == 18:
-                    o1 = 0
-                m1 = M1[y, x]
-                R[yb0 + 1, xb0 + 1, o1] += (1.0 - yd) * (1.0 - xd) * m1
-                R[yb0 + 1, xb0 + 2, o1] += (1.0 - yd) * xd * m1
-                R[yb0 + 2, xb0 + 1, o1] += yd * (1.0 - xd) * m1
-                R[yb0 + 2, xb0 + 2, o1] += yd * xd * m1
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
-def _fhog_into(img, cell, clip, out, off, soft):
+def _fhog_into(img, cell, clip, out, off):
     """Write the 31 fHOG channels of ``img`` (H, W, C) float32 into ``out[off:off+31]`` (see module doc)."""
     H, W, C = img.shape
     hb = H // cell
     wb = W // cell
     O0 = np.empty((H, W), np.int32)
     M0 = np.empty((H, W), np.float32)
-    M1 = np.empty((H, W), np.float32)
-    _grad_bins(img, cell, O0, M0, M1, soft)
+    _grad_bins(img, cell, O0, M0)
     Rp = np.zeros((hb + 2, wb + 2, 18), np.float32)
-    _accumulate(O0, M0, M1, cell, Rp, soft)
+    _accumulate(O0, M0, cell, Rp)
     R1 = np.empty((18, hb, wb), np.float32)
     for i in range(hb):
         for j in range(wb):
@@ -237,7 +213,7 @@ def fhog(img: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
     if a.shape[0] < 2 or a.shape[1] < 2:
         raise ValueError(f"fhog needs an image of at least 2x2 pixels, got {a.shape[:2]}")
     out = np.zeros((N_HOG, a.shape[0] // cell, a.shape[1] // cell), np.float32)
-    _fhog_into(a, cell, np.float32(clip), out, 0, False)
+    _fhog_into(a, cell, np.float32(clip), out, 0)
     return out
 
 
@@ -308,14 +284,14 @@ def extract(patch_bgr: np.ndarray, colour: bool, cell: int = CELL, out: np.ndarr
     if out is None:
         out = np.empty(shape, np.float32)
     _colour_into(a, cell, colour_names(), colour, out, 0, 1 + N_HOG)
-    _fhog_into(a.astype(np.float32), cell, np.float32(0.2), out, 1, False)
+    _fhog_into(a.astype(np.float32), cell, np.float32(0.2), out, 1)
     return out
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _fhog_batch(patches, cell, clip, out):
     for k in range(patches.shape[0]):
-        _fhog_into(patches[k], cell, clip, out[k], 0, False)
+        _fhog_into(patches[k], cell, clip, out[k], 0)
 
 
 def fhog_batch(patches: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:

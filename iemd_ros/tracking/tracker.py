@@ -161,6 +161,8 @@ class IemdTracker:
         self._confidence = None  # running mean of the filter's response at the window over frames that learned
         self._search_part = 0  # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
         self._lost_frames = 0  # lost frames in a row
+        self._anchor = None  # lost: where the target was lost, moved by the priors since (re-detection looks there)
+        self._prediction = None  # this frame's predicted centre
 
     def update(self, frame: np.ndarray, prior=None) -> TrackResult:
         """Track the target into ``frame``.
@@ -187,42 +189,49 @@ class IemdTracker:
         if self._center is None:
             raise RuntimeError("IemdTracker.update() called before init()")
         _check_frame(frame)
-        center, size, angle = self._center.copy(), self._size.copy(), self._angle
+        center, size, angle, anchor = self._center.copy(), self._size.copy(), self._angle, self._anchor
         if prior is not None:  # may raise ValueError: before any state changes, so a retry sees none
             prior = _check_prior(prior)
             center, size, turn = _apply_prior(prior, center, size)
             angle = _wrap_angle(angle + turn)
+            anchor = None if anchor is None else _apply_prior(prior, anchor, size)[0]
         self._frame_index += 1
+        self._anchor, self._prediction = anchor, center
         predicted = _box(center, size, angle)
         previous, grey, pyramid = self._take_frame(frame)
         visible = _visible_fraction(center, size, angle, frame.shape)
-        if visible < self.config.min_visible:  # the prior moved the window out of view: keep its place, search nothing
-            return self._lose(center, size, angle, predicted, Cause.OUT_OF_VIEW,
-                              f"only {visible:.0%} of the predicted window is inside the image")
-        if self._lost and self._translation_filter is not None:
-            return self._redetect(frame, pyramid, center, size, angle, predicted)
+        cfg = self.config
+        if visible < cfg.min_visible:  # the prior moved the window out of view: keep its place, search only the frame
+            redetected = self._redetect(frame, pyramid, size, angle, predicted, 0, 0) if self._lost else None
+            return redetected or self._lose(center, size, angle, predicted, Cause.OUT_OF_VIEW,
+                                            f"only {visible:.0%} of the predicted window is inside the image")
         best, searches, starts = self._search_all(frame, previous, grey, pyramid, prior, center, size, angle)
-        final, scale = _Descent(model=best.model, emd=best.emd), 1.0  # a held frame keeps the window's size
-        if not best.held_reason:
+        final, scale = _Descent(model=best.model, emd=best.emd), 1.0  # held or lost: the window keeps its size
+        if not best.held_reason and not self._lost:
             final, scale = self._estimate_scale(frame, best, _scale_bounds(best.model.size, frame.shape))
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
+        codings = sum(s.codings for s in searches) + final.codings
         cause, reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
-        if cause is None:
-            cause, reason = self._peak_check()
-        if cause is not None:
-            return self._lose(center, size, angle, predicted, cause, reason, emd=emd, searched=best,
-                              starts=starts, codings=sum(s.codings for s in searches) + final.codings)
-        lost = self._lost = False
-        self._lost_frames = 0
+        if cause is None:  # lost until the peak is back to found_response x its mean: hysteresis
+            cause, reason = self._peak_check(cfg.found_response if self._lost else cfg.lost_response)
+        if cause is not None and self._lost:
+            redetected = self._redetect(frame, pyramid, size, angle, predicted, starts, codings)
+            if redetected is not None:
+                return redetected
+        if cause is not None:  # the window follows the local search (not out of the image), without learning
+            kept = center if cause is Cause.OUT_OF_VIEW else new_center
+            return self._lose(kept, size, angle, predicted, cause, reason, emd=emd, searched=best, starts=starts,
+                              codings=codings)
+        self._lost, self._lost_frames, self._anchor = False, 0, None
         held = bool(best.held_reason)
         self._center, self._size, self._angle = new_center, new_size, angle
-        if not lost and not held:
-            self._learn(frame, final, best.confidence, new_center, new_size, angle)
         if held:
             cause, reason = Cause.LOW_RESPONSE, best.held_reason
+        else:
+            self._learn(frame, final, best.confidence, new_center, new_size, angle)
         return TrackResult(
-            box=_box(new_center, new_size, angle), emd=emd, iterations=best.iterations, lost=lost, scale=scale,
-            angle=angle, starts=starts, codings=sum(s.codings for s in searches) + final.codings,
+            box=_box(new_center, new_size, angle), emd=emd, iterations=best.iterations, lost=False, scale=scale,
+            angle=angle, starts=starts, codings=codings,
             solver_warnings=sum(s.warnings for s in searches) + final.warnings, predicted_box=predicted,
             reason=reason, held=held, cause=cause,
         )
@@ -230,50 +239,58 @@ class IemdTracker:
     # ------------------------------------------------------------ internals
     def _lose(self, center, size, angle, predicted, cause: Cause, reason: str, emd: float = float("inf"),
               searched: _Descent | None = None, starts: int = 0, codings: int = 0) -> TrackResult:
-        """The lost frame's result; the window keeps its predicted place (it moves with the prior while lost)."""
+        """The lost frame's result: the window is kept at ``center`` (the prediction, or where the local search took
+        it), so it moves with the prior while lost; on the first lost frame the predicted centre becomes the place
+        re-detection looks at."""
+        if not self._lost:
+            self._anchor = np.asarray(self._prediction, dtype=np.float64)
         self._center, self._size, self._angle, self._lost = center, size, angle, True
         self._lost_frames += 1
-        return TrackResult(box=predicted, emd=emd, iterations=searched.iterations if searched else 0, lost=True,
-                           angle=angle, starts=starts, codings=codings, predicted_box=predicted, reason=reason,
-                           cause=cause)
+        return TrackResult(box=_box(center, size, angle), emd=emd, iterations=searched.iterations if searched else 0,
+                           lost=True, angle=angle, starts=starts, codings=codings, predicted_box=predicted,
+                           reason=reason, cause=cause)
 
-    def _peak_check(self) -> tuple[Cause | None, str]:
-        """(NO_PEAK, reason) when the translation filter's peak near the prediction is below ``lost_response``
-        times the running mean of its response on learned frames (LCT's re-detection trigger), else (None, "")."""
+    def _peak_check(self, threshold: float) -> tuple[Cause | None, str]:
+        """(NO_PEAK, reason) when the translation filter's peak near the prediction is below ``threshold`` times the
+        running mean of its response on learned frames (LCT's re-detection trigger), else (None, "")."""
         if self._translation_filter is None or self._confidence is None:
             return None, ""
         peak = self._translation_filter.confidence["peak"]
-        if peak >= self.config.lost_response * self._confidence:
+        if peak >= threshold * self._confidence:
             return None, ""
-        return Cause.NO_PEAK, (f"filter peak {peak:.3f} < {self.config.lost_response} x its running mean "
-                               f"{self._confidence:.3f}")
+        return Cause.NO_PEAK, f"filter peak {peak:.3f} < {threshold} x its running mean {self._confidence:.3f}"
 
-    def _redetect(self, frame, pyramid, center, size, angle, predicted) -> TrackResult:
-        """A lost frame: the filter searched around the prediction, then, after ``FRAME_SEARCH_AFTER`` lost frames
-        (a short loss is found near where it happened), one strip of the whole frame (a scan of the frame spread over
-        lost frames); the best peak is taken when it reaches ``found_response`` times the running
-        mean and its window's EMD is below the lost limit.  Nothing learns from the frame."""
+    def _redetect(self, frame, pyramid, size, angle, predicted, starts: int, codings: int) -> TrackResult | None:
+        """A lost frame the local search did not confirm: the filter searched where the target was lost (that place
+        moved by the priors since), then, lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near
+        where it happened), one strip of the whole frame (the frame is scanned over lost frames) refined by a search
+        at its peak.  The result when the best peak reaches ``found_response`` times the running mean and its
+        window's EMD is below the lost limit, else None.  Nothing learns from the frame."""
         tf, cfg = self._translation_filter, self.config
-        found = center + tf.estimate(frame, center, size, angle)
-        peak, starts = tf.confidence["peak"], 1
-        if peak < cfg.found_response * self._confidence and self._lost_frames >= FRAME_SEARCH_AFTER:
+        if tf is None:
+            return None
+        candidates = []
+        if _visible_fraction(self._anchor, size, angle, frame.shape) >= cfg.min_visible:
+            candidates.append(self._anchor + tf.estimate(frame, self._anchor, size, angle))
+            candidates[-1] = (candidates[-1], tf.confidence["peak"])
+        if self._lost_frames >= FRAME_SEARCH_AFTER and not (candidates and candidates[0][1] >= cfg.found_response
+                                                            * self._confidence):
             coarse, _, parts = tf.search_frame(frame, size, self._search_part)
             self._search_part = (self._search_part + 1) % parts
-            refined = coarse + tf.estimate(frame, coarse, size, angle)
-            starts += 1
-            if tf.confidence["peak"] > peak:
-                found, peak = refined, tf.confidence["peak"]
+            candidates.append((coarse + tf.estimate(frame, coarse, size, angle), tf.confidence["peak"]))
+        if not candidates:
+            return None
+        found, peak = max(candidates, key=lambda c: c[1])
         if peak < cfg.found_response * self._confidence:
-            return self._lose(center, size, angle, predicted, Cause.NO_PEAK,
-                              f"searching: best filter peak {peak:.3f} < {cfg.found_response} x its running mean "
-                              f"{self._confidence:.3f}", starts=starts)
+            return None
         emd = CandidateModel(self._context(pyramid, angle), found, size).emd()[0]
-        cause, reason = self._lost_reason(emd, found, size, angle, frame.shape)
-        if cause is not None:
-            return self._lose(center, size, angle, predicted, cause, reason, emd=emd, starts=starts, codings=1)
+        if self._lost_reason(emd, found, size, angle, frame.shape)[0] is not None:
+            return None
         self._center, self._size, self._angle, self._lost, self._lost_frames = found, size, angle, False, 0
+        self._anchor = None
         return TrackResult(box=_box(found, size, angle), emd=emd, iterations=0, lost=False, angle=angle,
-                           starts=starts, codings=1, predicted_box=predicted, cause=Cause.REDETECTED,
+                           starts=starts + len(candidates), codings=codings + 1, predicted_box=predicted,
+                           cause=Cause.REDETECTED,
                            reason=f"re-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean")
 
     def _search_all(self, frame, previous, grey, pyramid, prior, center, size, angle):
