@@ -12,7 +12,7 @@ import numpy as np
 
 from iemd_ros.tracking.appearance import window_axes
 
-__all__ = ["sample_region", "hann_inner", "gaussian_label", "apce", "peak_to_sidelobe", "SubCellPeak"]
+__all__ = ["sample_region", "hann_inner", "gaussian_label", "apce", "SubCellPeak"]
 
 
 # ---------------------------------------------------------------------------------------------- sampling
@@ -114,18 +114,6 @@ def apce(resp: np.ndarray) -> float:
     mx, mn = float(resp.max()), float(resp.min())
     den = float(np.mean((resp - mn) ** 2))
     return (mx - mn) ** 2 / den if den > 0 else 0.0
-
-
-def peak_to_sidelobe(resp: np.ndarray, exclude: int = 2) -> float:
-    """MOSSE's peak-to-sidelobe ratio ``(max - mean) / std`` of the response outside the peak's
-    ``(2 exclude + 1)^2`` neighbourhood (circular)."""
-    r, c = np.unravel_index(int(np.argmax(resp)), resp.shape)
-    mask = np.ones(resp.shape, bool)
-    mask[np.ix_(np.arange(r - exclude, r + exclude + 1) % resp.shape[0],
-                np.arange(c - exclude, c + exclude + 1) % resp.shape[1])] = False
-    side = resp[mask]
-    sd = float(side.std())
-    return (float(resp[r, c]) - float(side.mean())) / sd if sd > 0 else 0.0
 
 
 class SubCellPeak:

@@ -255,7 +255,7 @@ class IemdTracker:
         running mean of its response on learned frames (LCT's re-detection trigger), else (None, "")."""
         if self._translation_filter is None or self._confidence is None:
             return None, ""
-        peak = self._translation_filter.confidence["peak"]
+        peak = self._translation_filter.response_peak
         if peak >= threshold * self._confidence:
             return None, ""
         return Cause.NO_PEAK, f"filter peak {peak:.3f} < {threshold} x its running mean {self._confidence:.3f}"
@@ -269,19 +269,16 @@ class IemdTracker:
         tf, cfg = self._translation_filter, self.config
         if tf is None:
             return None
-        candidates = []
+        wanted = cfg.found_response * self._confidence
+        candidates = []  # (centre, filter peak there)
         if _visible_fraction(self._anchor, size, angle, frame.shape) >= cfg.min_visible:
-            candidates.append(self._anchor + tf.estimate(frame, self._anchor, size, angle))
-            candidates[-1] = (candidates[-1], tf.confidence["peak"])
-        if self._lost_frames >= FRAME_SEARCH_AFTER and not (candidates and candidates[0][1] >= cfg.found_response
-                                                            * self._confidence):
+            candidates.append(self._filter_peak(frame, self._anchor, size, angle))
+        if self._lost_frames >= FRAME_SEARCH_AFTER and not (candidates and candidates[0][1] >= wanted):
             coarse, _, parts = tf.search_frame(frame, size, self._search_part)
             self._search_part = (self._search_part + 1) % parts
-            candidates.append((coarse + tf.estimate(frame, coarse, size, angle), tf.confidence["peak"]))
-        if not candidates:
-            return None
-        found, peak = max(candidates, key=lambda c: c[1])
-        if peak < cfg.found_response * self._confidence:
+            candidates.append(self._filter_peak(frame, coarse, size, angle))
+        found, peak = max(candidates, key=lambda c: c[1], default=(None, -np.inf))
+        if peak < wanted:
             return None
         emd = CandidateModel(self._context(pyramid, angle), found, size).emd()[0]
         if self._lost_reason(emd, found, size, angle, frame.shape)[0] is not None:
@@ -292,6 +289,11 @@ class IemdTracker:
                            starts=starts + len(candidates), codings=codings + 1, predicted_box=predicted,
                            cause=Cause.REDETECTED,
                            reason=f"re-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean")
+
+    def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float]:
+        """(where the translation filter's response peaks in the region around ``at``, its value)."""
+        tf = self._translation_filter
+        return at + tf.estimate(frame, at, size, angle), tf.response_peak
 
     def _search_all(self, frame, previous, grey, pyramid, prior, center, size, angle):
         """(best descent, every search run, starts searched) from the prediction ``center``: the fine starts

@@ -55,7 +55,7 @@ class TranslationFilter:
         self.f = None
         self._detection = self._response = None
         self._frame_filter = None  # (f, shape, its conjugate spectrum at that shape) for search_frame
-        self.confidence = {}
+        self.response_peak = None  # the last estimate's peak value
 
     def init(self, frame: np.ndarray, center, size, colour: bool, angle: float = 0.0) -> None:
         """Set up the sample geometry from the first window and learn the first filter (``mu = 0``).
@@ -100,7 +100,7 @@ class TranslationFilter:
     # ------------------------------------------------------------------ detection
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
         """Where the response of the current filter peaks, as a displacement (dx, dy) px from ``center``; the
-        response is kept for :meth:`response_at` and :attr:`confidence`.
+        response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
 
         Parameters
         ----------
@@ -126,7 +126,7 @@ class TranslationFilter:
         cell_px = features.CELL * scale
         self._detection = (id(frame), pos, scale, angle, zf)
         self._response = (resp, pos, cell_px, window_axes(angle))
-        self.confidence = {"peak": value, "apce": apce(resp)}
+        self.response_peak = value
         return window_axes(angle) @ (np.array([dx, dy]) * cell_px) + pos - np.asarray(center, dtype=np.float64)
 
     def response_at(self, point) -> float:
@@ -160,7 +160,7 @@ class TranslationFilter:
         centre : ndarray
             (cx, cy) of the strongest response in the strip, image px (pixel centres at integers).
         response : float
-            The response there (no cosine window, so not comparable with :attr:`confidence`: check a candidate
+            The response there (no cosine window, so not comparable with :attr:`response_peak`: check a candidate
             with :meth:`estimate`).
         parts : int
             How many strips the frame has at this scale.
@@ -188,6 +188,14 @@ class TranslationFilter:
         k = np.unravel_index(int(np.argmax(resp)), resp.shape)
         centre = (np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5) * features.CELL * ratio - 0.5
         return centre, float(resp[k]), parts
+
+    @property
+    def confidence(self) -> dict:
+        """The last estimate's peak value and APCE (LMCF's average peak-to-correlation energy), computed when asked;
+        {} before any estimate."""
+        if self._response is None:
+            return {}
+        return {"peak": self.response_peak, "apce": apce(self._response[0])}
 
     # ------------------------------------------------------------------ learning
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
