@@ -12,7 +12,7 @@ from iemd_ros.evaluation.metrics import iou
 from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.template import TemplateDictionary
 from iemd_ros.tracking.analysis import descend, search_context
-from iemd_ros.tracking.tracker import MIN_SIDE_PX, _scale_bounds, _visible_fraction
+from iemd_ros.tracking.tracker import MIN_SIDE_PX, Cause, _scale_bounds, _visible_fraction
 
 
 @pytest.mark.parametrize("bad,match", [
@@ -164,6 +164,17 @@ def test_target_leaving_the_image_is_reported_lost():
     moved = np.concatenate([frame[:, 60:], texture(seed=4)[:, :60]], axis=1)
     result = tracker.update(moved, prior=H)
     assert result.lost and "inside the image" in result.reason
+
+
+def test_a_target_lost_before_any_frame_learned_stays_lost_frame_after_frame():
+    """Lost on the first update (the prior moves the window off the image), so no response has been learned to
+    compare a re-detection with: the next lost frames are reported lost, not a TypeError."""
+    frame = texture(seed=3)
+    tracker = IemdTracker()
+    tracker.init(frame, (2.0, 100.0, 40.0, 40.0))
+    H = np.array([[1, 0, -80.0], [0, 1, 0], [0, 0, 1]])
+    results = [tracker.update(frame, prior=H) for _ in range(3)]
+    assert all(r.lost and r.cause is Cause.OUT_OF_VIEW for r in results)
 
 
 def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):

@@ -267,7 +267,7 @@ class IemdTracker:
         at its peak.  The result when the best peak reaches ``found_response`` times the running mean and its
         window's EMD is below the lost limit, else None.  Nothing learns from the frame."""
         tf, cfg = self._translation_filter, self.config
-        if tf is None:
+        if tf is None or self._confidence is None:  # no frame learned yet: no response to compare a candidate with
             return None
         wanted = cfg.found_response * self._confidence
         candidates = []  # (centre, filter peak there)
