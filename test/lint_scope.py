@@ -1,0 +1,43 @@
+"""What the ament lint tests (test_flake8, test_pep257, test_copyright) check: every .py file of the repository.
+
+Left out: folders starting with '.' or '_' (as ament's linters do), the build outputs that pip and colcon leave
+in the source tree, and PENDING.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+
+# `pip install .` (scripts/setup_venv.sh) leaves build/ beside setup.py; colcon's build/install/log when the
+# repository is the workspace; out/ holds benchmark and evaluation outputs.
+BUILD_OUTPUTS = ('build', 'install', 'log', 'out')
+
+# Files being reworked on another branch while the lint fixes landed.  They are brought in line when that work
+# lands (the lint fix script, then the hand fixes the linters still ask for), and removed from here.
+PENDING = (
+    'iemd_ros/tracking',
+    'test/test_correlation_filter.py',
+    'test/test_scale_filter.py',
+    'test/test_tracker.py',
+    'test/test_translation_filter.py',
+)
+
+
+def excluded_paths() -> list[str]:
+    """Absolute paths of the build outputs and PENDING, for the linters' ``--exclude``."""
+    return [str(REPO / p) for p in BUILD_OUTPUTS + PENDING]
+
+
+def python_files() -> list[Path]:
+    """Every .py file the lint tests check, sorted."""
+    skip = [REPO / p for p in BUILD_OUTPUTS + PENDING]
+    files = []
+    for path in REPO.rglob('*.py'):
+        rel = path.relative_to(REPO)
+        if any(part.startswith(('.', '_')) for part in rel.parts[:-1]):
+            continue
+        if any(path == s or s in path.parents for s in skip):
+            continue
+        files.append(path)
+    return sorted(files)
