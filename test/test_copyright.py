@@ -1,9 +1,41 @@
-"""Copyright and licence headers: ament_copyright where a ROS install has it, and the project's own check.
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
-ament_copyright has no PyPI wheel, so on a pip-only machine (CI) only the own check runs.  It asks of every
-.py file what ament_copyright's ``bsd_3clause`` license accepts, plus the SPDX identifier of package.xml's
-licence: a first comment block (after a shebang line) that starts with the copyright line and holds the
-3-Clause BSD text.
+"""
+Copyright and licence headers.
+
+ament_copyright where a ROS install has it, and the project's own check.
+
+ament_copyright has no PyPI wheel, so on a pip-only machine (CI) only the own check runs.  It asks
+of every .py file what ament_copyright's ``bsd_3clause`` license accepts, plus the SPDX identifier
+of package.xml's licence: a first comment block (after a shebang line) that starts with the
+copyright line and holds the 3-Clause BSD text.
 """
 import re
 
@@ -17,28 +49,41 @@ except ImportError:
 
 COPYRIGHT = re.compile(r'^Copyright \d{4}(-\d{4})? iemd_ros authors$')
 SPDX = 'SPDX-License-Identifier: BSD-3-Clause'
-# The 3-Clause BSD text as ament_copyright's bsd_3clause template has it, in two parts around the copyright
-# holder's name; compared with the whitespace collapsed, as ament_copyright compares.
+# The 3-Clause BSD text as ament_copyright's bsd_3clause template has it, in two parts around the
+# copyright holder's name; compared with the whitespace collapsed, as ament_copyright compares.
 BSD_3CLAUSE = (
-    'Redistribution and use in source and binary forms, with or without modification, are permitted provided '
-    'that the following conditions are met: * Redistributions of source code must retain the above copyright '
-    'notice, this list of conditions and the following disclaimer. * Redistributions in binary form must '
-    'reproduce the above copyright notice, this list of conditions and the following disclaimer in the '
-    'documentation and/or other materials provided with the distribution. * Neither the name of the',
-    'nor the names of its contributors may be used to endorse or promote products derived from this software '
-    'without specific prior written permission. THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND '
-    'CONTRIBUTORS "AS IS" AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE IMPLIED '
-    'WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE ARE DISCLAIMED. IN NO EVENT SHALL THE '
-    'COPYRIGHT HOLDER OR CONTRIBUTORS BE LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR '
-    'CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF SUBSTITUTE GOODS OR SERVICES; LOSS OF '
-    'USE, DATA, OR PROFITS; OR BUSINESS INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER '
-    'IN CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE) ARISING IN ANY WAY OUT OF THE '
+    'Redistribution and use in source and binary forms, with or without modification, are '
+    'permitted provided '
+    'that the following conditions are met: * Redistributions of source code must retain the '
+    'above copyright '
+    'notice, this list of conditions and the following disclaimer. * Redistributions in binary '
+    'form must '
+    'reproduce the above copyright notice, this list of conditions and the following disclaimer '
+    'in the '
+    'documentation and/or other materials provided with the distribution. * Neither the name of '
+    'the',
+    'nor the names of its contributors may be used to endorse or promote products derived from '
+    'this software '
+    'without specific prior written permission. THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT '
+    'HOLDERS AND '
+    'CONTRIBUTORS "AS IS" AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, '
+    'THE IMPLIED '
+    'WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE ARE DISCLAIMED. IN NO '
+    'EVENT SHALL THE '
+    'COPYRIGHT HOLDER OR CONTRIBUTORS BE LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, '
+    'EXEMPLARY, OR '
+    'CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF SUBSTITUTE GOODS OR '
+    'SERVICES; LOSS OF '
+    'USE, DATA, OR PROFITS; OR BUSINESS INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF '
+    'LIABILITY, WHETHER '
+    'IN CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE) ARISING IN ANY '
+    'WAY OUT OF THE '
     'USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE POSSIBILITY OF SUCH DAMAGE.',
 )
 
 
 def header_problem(text):
-    """What is wrong with a file's header, or None."""
+    """Return what is wrong with a file's header, or None."""
     lines = text.split('\n')
     if lines and lines[0].startswith('#!'):
         lines = lines[1:]
@@ -76,7 +121,8 @@ def test_every_python_file_has_the_project_header():
     bad = []
     for path in files:
         text = path.read_text(encoding='utf-8')
-        problem = text.strip() and header_problem(text)  # empty files need none (nor does ament_copyright)
+        # empty files need none (nor does ament_copyright)
+        problem = text.strip() and header_problem(text)
         if problem:
             bad.append('%s: %s' % (path.relative_to(REPO), problem))
     assert not bad, '%d file(s) without the header:\n' % len(bad) + '\n'.join(bad)
@@ -84,8 +130,10 @@ def test_every_python_file_has_the_project_header():
 
 @pytest.mark.copyright
 @pytest.mark.linter
-@pytest.mark.skipif(ament_copyright_main is None,
-                    reason='ament_copyright is not installed (no PyPI wheel; a ROS 2 install has it)')
+@pytest.mark.skipif(
+    ament_copyright_main is None,
+    reason='ament_copyright is not installed (no PyPI wheel; a ROS 2 install has it)',
+)
 def test_copyright(monkeypatch):
     monkeypatch.chdir(REPO)
     rc = ament_copyright_main(argv=[str(p.relative_to(REPO)) for p in python_files()])
