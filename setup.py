@@ -71,7 +71,11 @@ sys.exit({function}())
 
 
 def ros_executables() -> list[str]:
-    """Write the wrappers (relative paths, as data_files wants them) for this build's interpreter."""
+    """
+    Write the wrappers for this build's interpreter.
+
+    (relative paths, as data_files wants them).
+    """
     os.makedirs(os.path.join(HERE, WRAPPER_DIR), exist_ok=True)
     paths = []
     for name, (module, function) in EXECUTABLES.items():

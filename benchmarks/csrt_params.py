@@ -28,13 +28,15 @@
 # ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
 # POSSIBILITY OF SUCH DAMAGE.
 
-"""How much of the peer's lead comes from its settings?  OpenCV's CSRT with some of its parameters changed.
+"""
+OpenCV's CSRT with some of its parameters changed: how much of the peer's lead is its settings.
 
     python benchmarks/csrt_params.py [--sequences Jogging-1,Jogging-2,Woman,Bolt2] [--jobs 2]
 
 Each variant sets a few fields of ``cv2.TrackerCSRT_Params`` (the rest are OpenCV's defaults, which
-``iemd-eval`` runs) and tracks every sequence once from the ground truth; printed: the average overlap
-per sequence (iemd_ros.evaluation.metrics), per variant.  The README ("Where the gap to CSRT is") quotes it.
+``iemd-eval`` runs) and tracks every sequence once from the ground truth; printed: the average
+overlap per sequence (iemd_ros.evaluation.metrics), per variant.  The README ("Where the gap to
+CSRT is") quotes it.
 """
 
 from __future__ import annotations

@@ -87,7 +87,7 @@ def _run(name: str, args: list[str], where: list[str], out: Path) -> tuple[float
 
 
 def _timed(run) -> tuple[float, float, str, float]:
-    """``run()``'s figures and the CPU seconds spent meanwhile by this process and its children."""
+    """Return ``run()``'s figures and the CPU seconds this process and its children spent."""
     cpu = _cpu_s()
     figures = run()
     return (*figures, _cpu_s() - cpu)

@@ -57,7 +57,7 @@ DESK_D = (-0.346217, 0.128289, 0.0, 0.0, 0.0)
 
 def errors(seq, cfg: GyroConfig | None, lens_aware: bool = True) -> np.ndarray:
     """
-    Centre errors (px) of the prediction.
+    Return the prediction's centre errors, px.
 
     ``cfg=None`` means no prediction (previous position).
     """

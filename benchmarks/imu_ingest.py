@@ -109,7 +109,7 @@ def messy_stream(n: int = 4000, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
 
 def check_same(old_imu, new_imu) -> None:
     """
-    ValueError unless both versions give the same statuses, counters and samples.
+    Raise ValueError unless both versions give the same statuses, counters and samples.
 
     One message at a time.
     """
@@ -145,7 +145,7 @@ def one_sample_adds(add, period_ns: int = 5 * MS):
 
 
 def cases(imu, pipeline, rotation) -> dict:
-    """name -> (factory of a timed call, calls per round, samples per call) for one version."""
+    """Return name -> (factory of a timed call, calls per round, samples per call), one version."""
     q = rotation.quat_normalize([0.9, 0.1, -0.2, 0.3])
     cal = rotation.GyroCalibration(
         np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]]), [0.02, -0.015, 0.01]

@@ -30,7 +30,8 @@
 """
 Image-in to detection-out latency of the tracker node (p50 / p95), 640x480 at 30 Hz.
 
-    .venv/bin/python benchmarks/latency.py [--frames 150] [--rate 30] [--width 640 --height 480] [--targets 3]
+    .venv/bin/python benchmarks/latency.py [--frames 150] [--rate 30] [--width 640 --height 480]
+                                           [--targets 3]
 
 A driver node publishes a synthetic shaky-camera sequence (bgr8 frames, IMU at 200 Hz, CameraInfo)
 with sensor-data QoS, as a camera driver would, and times each frame from just before ``publish``

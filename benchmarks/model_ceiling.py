@@ -80,7 +80,7 @@ def grid_argmin(score, centre, size, offsets=OFFSETS) -> np.ndarray:
 
 
 def _grid_argmin_iou(score, truth) -> float:
-    """IoU with ``truth`` of the window of the lowest ``score(centre)`` on the offset grid."""
+    """Return the IoU with ``truth`` of the window of the lowest ``score(centre)`` on the grid."""
     size = truth[2:]
     dx, dy = grid_argmin(score, box_centre(truth), size)
     best = (truth[0] + dx * size[0], truth[1] + dy * size[1], size[0], size[1])

@@ -54,9 +54,10 @@ thread, the serial loop), and with ``--baseline TREE`` another checkout of iemd_
 worktree`` of an older commit) run by the same Python; each run's × real time is printed, then the
 medians.  ``--bag`` replays an existing bag instead of making one.
 
-    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py [--frames N] [--no-gyro-too] [--compress C ...]
-                                                             [--keep DIR]
-    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py --whole 5 [--bag BAG] [--baseline TREE]
+    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py [--frames N] [--no-gyro-too]
+                                                             [--compress C ...] [--keep DIR]
+    PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py --whole 5 [--bag BAG]
+                                                             [--baseline TREE]
 """
 from __future__ import annotations
 

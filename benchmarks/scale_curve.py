@@ -96,8 +96,12 @@ def curve(job):
 
 
 def oracle_translation(job):
-    """Mean |log(size / ground-truth size)| of the tracker whose window a translation prior moves to the
-    ground-truth centre before each update (the public API: no private state is set)."""
+    """
+    Mean |log(size / ground-truth size)| of the tracker with an oracle translation prior.
+
+    The prior moves the tracker's window to the ground-truth centre before each update (the public
+    API: no private state is set).
+    """
     name, config = job
     seq = load_sequence(name)
     tracker = IemdTracker(TrackerConfig.from_dict(dict(n_iter=0, flow_start=False, **config)))

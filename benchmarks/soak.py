@@ -32,7 +32,8 @@ Bounded soak of the tracker node as its own process.
 
 RSS sampled over a run of fixed length, and its slope.
 
-    .venv/bin/python benchmarks/soak.py [--minutes 30] [--rate 30] [--width 640 --height 480] [--sample-s 10]
+    .venv/bin/python benchmarks/soak.py [--minutes 30] [--rate 30] [--width 640 --height 480]
+                                        [--sample-s 10]
 
 The tracker runs as ``python -m iemd_ros.ros.node`` (the installed package unless PYTHONPATH says
 otherwise) on an isolated DDS domain on this host; this process publishes a synthetic shaky-camera

@@ -28,7 +28,7 @@
 # POSSIBILITY OF SUCH DAMAGE.
 
 """
-Start-up of the installed package.
+Start-up of the installed package: node start -> first detection, and a 2-frame replay.
 
 Time from starting the node to its first detection, and the whole run of ``iemd-replay`` on a
 2-frame bag, with numba's cache empty (a fresh install without ``iemd-compile``) and full (after
@@ -175,7 +175,7 @@ def _replay_run(bag: Path, init: str) -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
     ap.add_argument('--runs', type=int, default=3)
     a = ap.parse_args(argv)
     os.environ.setdefault('ROS_DOMAIN_ID', str(np.random.default_rng().integers(30, 100)))

@@ -114,7 +114,8 @@ def main():
         rows = results[ci * len(names): (ci + 1) * len(names)]
         cells = ' '.join(f'{n}={ao * 100:5.1f}%' for n, (ao, _) in zip(names, rows))
         speed = np.median([ms for _, ms in rows])
-        line = f'{str(config):70s} {cells}  mean={np.mean([r[0] for r in rows]) * 100:5.1f}%  median update {speed:.1f} ms'
+        line = (f'{str(config):70s} {cells}  mean={np.mean([r[0] for r in rows]) * 100:5.1f}%  '
+                f'median update {speed:.1f} ms')
         if disc:
             d = disc[ci * len(names): (ci + 1) * len(names)]
             line += '  discrimination ' + ' '.join(

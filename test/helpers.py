@@ -152,8 +152,11 @@ def run_module(module: str, *args: str, timeout: float = 120, **kw) -> subproces
 
 
 def node_parameter_file(path: Path, **ros_parameters) -> Path:
-    """config/tracker.yaml (the node's parameter file) with ``ros_parameters`` set in its node section,
-    written to ``path``."""
+    """
+    Write config/tracker.yaml (the node's parameter file) to ``path``, with ``ros_parameters``.
+
+    They are set in its node section.
+    """
     import yaml  # noqa: PLC0415 - only the parameter-file tests need it
 
     params = yaml.safe_load((REPO / 'config' / 'tracker.yaml').read_text())

@@ -105,8 +105,11 @@ def isolated_ros_env():
 
 
 def child_env(base) -> dict:
-    """``base`` with the domain and discovery range of the enclosing isolated_ros_env / ros_context,
-    for a child process that must meet the test's nodes."""
+    """
+    Return ``base`` with the domain and discovery range of the enclosing ROS environment.
+
+    That is isolated_ros_env / ros_context, for a child process that must meet the test's nodes.
+    """
     return {**base, **{k: os.environ[k] for k in _ISOLATION_KEYS}}
 
 
@@ -228,8 +231,12 @@ class Driver:
     def publish_imu_until(
         self, seq, t_cam_ns: int, sent: int = 0, frame_id: str = FRAME_ID
     ) -> int:
-        """Publish ``seq``'s gyro samples from index ``sent`` up to the IMU time of the frame stamped
-        ``t_cam_ns`` (+5 ms), as a real IMU stream would; returns the index of the next sample."""
+        """
+        Publish ``seq``'s gyro samples from index ``sent`` as a real IMU stream would.
+
+        Up to the IMU time of the frame stamped ``t_cam_ns`` (+5 ms); returns the index of the next
+        sample.
+        """
         t_imu = t_cam_ns + seq.time_offset_ns + 5_000_000
         while sent < len(seq.gyro_t_ns) and seq.gyro_t_ns[sent] <= t_imu:
             self.publish_imu(int(seq.gyro_t_ns[sent]), seq.gyro[sent], frame_id)

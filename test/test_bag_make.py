@@ -287,7 +287,7 @@ def test_otb_folder(otb_root, tmp_path):
 
 
 def _three_frame_folder(seq, tmp_path) -> Path:
-    """An image folder (no stamps, IMU or calibration) with the first 3 frames of ``seq``."""
+    """Write an image folder (no stamps, IMU or calibration) with the first 3 frames of ``seq``."""
     folder = tmp_path / 'imgs'
     folder.mkdir()
     for k in range(3):

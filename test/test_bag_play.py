@@ -62,7 +62,7 @@ import pytest
 rclpy = pytest.importorskip('rclpy')
 pytest.importorskip('vision_msgs.msg')
 
-from iemd_ros.apps.play import main  # noqa: E402
+from iemd_ros.apps.play import main  # noqa: E402, I100
 from iemd_ros.bags.make import source_from_folder, write_bag  # noqa: E402
 from iemd_ros.bags.replay import replay  # noqa: E402
 from iemd_ros.messages.conversions import stamp_ns  # noqa: E402

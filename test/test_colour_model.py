@@ -166,9 +166,12 @@ def test_the_tracker_uses_colour_on_colour_frames_only():
 
 
 def test_tracks_a_real_colour_otb_excerpt(otb_root):
-    """Woman frames 1-100 (a colour sequence, so the colour model is on and its start is searched, a fourth
-    after the prediction, the flow and the translation filter): average overlap > 0.7 (0.78 measured; 0.76 with
-    colour_weight 0)."""
+    """
+    Woman frames 1-100: average overlap > 0.7 (0.78 measured; 0.76 with colour_weight 0).
+
+    A colour sequence, so the colour model is on and its start is searched, a fourth after the
+    prediction, the flow and the translation filter.
+    """
     seq = load_sequence(otb_root / 'Woman')
     tracker = IemdTracker()
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])

@@ -170,7 +170,7 @@ def test_appearance_gradient_matches_finite_differences_of_the_resampled_emd():
 
 def test_patch_jacobian_matches_finite_differences_of_the_resampled_patches():
     """
-    d epsilon / d(window shift) of PatchLayout.extract_with_jacobian (numba) on a smooth image.
+    The d epsilon / d(window shift) of PatchLayout.extract_with_jacobian (numba), smooth image.
 
     Within 10 % (the central differences of the template's grey levels approximate the resampling's
     derivative).

@@ -149,7 +149,7 @@ def test_the_window_flow_never_gives_opencv_an_empty_or_non_finite_region(monkey
 
 
 def _gyro_stream_with(seq, rate: float, start_ns: int, length_ns: int):
-    """The sequence's gyro with the samples in [start, start + length) replaced by ``rate`` on every axis."""
+    """Return the gyro with the samples in [start, start + length) set to ``rate`` on each axis."""
     t = np.asarray(seq.gyro_t_ns)
     w = np.array(seq.gyro, dtype=float)
     w[(t >= start_ns) & (t < start_ns + length_ns)] = rate

@@ -335,7 +335,7 @@ def _messy_stream(n=3000, seed=7):
 
 
 def test_one_sample_at_a_time_matches_one_batch():
-    """Statuses, counters, stored samples and the newest stamp do not depend on how the stream is cut."""
+    """Statuses, counters, stored samples and newest stamp do not depend on the stream's cuts."""
     t, w = _messy_stream()
     half = len(t) // 2
     # arrives after the window below: late
@@ -398,8 +398,12 @@ def test_empty_and_all_rejected_batches_leave_the_stream_untouched():
 
 
 def test_samples_sharing_a_stamp_merge_without_overflowing():
-    """Found by test_fuzz: two finite rates near the float maximum at one stamp were averaged through their sum,
-    which overflowed to inf inside the buffer."""
+    """
+    Two finite rates near the float maximum at one stamp merge without overflowing.
+
+    Found by test_fuzz: they were averaged through their sum, which overflowed to inf inside the
+    buffer.
+    """
     buf = ImuBuffer()
     buf.add(
         np.array([0, 0, 10]), np.array([[0.0, 0.0, 8e307], [0.0, 0.0, 1e308], [0.0, 0.0, 0.0]])

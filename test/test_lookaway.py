@@ -75,7 +75,7 @@ def test_long_term_scores_by_hand():
 
 
 def _moving_target_sequence(tmp_path: Path, n: int = 90) -> Sequence:
-    """A 16x12 bright square moving 2 px per frame to the right over a 320x240 textured scene."""
+    """Return a 16x12 bright square moving 2 px per frame to the right over a 320x240 scene."""
     rng = np.random.default_rng(0)
     scene = cv2.GaussianBlur(rng.integers(0, 255, (240, 320, 3), dtype=np.uint8), (0, 0), 3)
     folder = tmp_path / 'src' / 'Mover'

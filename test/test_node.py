@@ -42,7 +42,7 @@ import pytest
 rclpy = pytest.importorskip('rclpy')
 pytest.importorskip('vision_msgs.msg')
 
-from iemd_ros.common.boxes import box_centre  # noqa: E402
+from iemd_ros.common.boxes import box_centre  # noqa: E402, I100
 from iemd_ros.datasets.synthetic import generate  # noqa: E402
 from iemd_ros.messages.conversions import bbox_values, image_from_msg, stamp_ns  # noqa: E402
 from iemd_ros.ros.node import TrackerNode  # noqa: E402

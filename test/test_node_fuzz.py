@@ -44,7 +44,7 @@ import pytest
 rclpy = pytest.importorskip('rclpy')
 pytest.importorskip('vision_msgs.msg')
 
-from iemd_ros.datasets.synthetic import generate  # noqa: E402
+from iemd_ros.datasets.synthetic import generate  # noqa: E402, I100
 from iemd_ros.messages.conversions import ENCODINGS, fill_image_msg, stamp_ns  # noqa: E402
 from iemd_ros.ros.parameters import parameters  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402

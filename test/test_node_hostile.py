@@ -41,7 +41,7 @@ import pytest
 rclpy = pytest.importorskip('rclpy')
 pytest.importorskip('vision_msgs.msg')
 
-from iemd_ros.datasets.synthetic import generate  # noqa: E402
+from iemd_ros.datasets.synthetic import generate  # noqa: E402, I100
 from iemd_ros.messages.conversions import stamp_ns  # noqa: E402
 from iemd_ros.tracking import IemdTracker  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
@@ -129,7 +129,7 @@ def test_absurd_focal_length_camera_info_then_imu_and_frames_do_not_stop_the_tra
 
 
 def test_a_1x1_frame_is_malformed_and_its_error_clears_on_the_next_good_frame(ctx, seq):
-    """A 1x1 mono8 frame gave ERROR "internal error: frame is empty" on every good frame after it."""
+    """A 1x1 mono8 frame gave ERROR "internal error: frame is empty" on every good frame after."""
     s = [int(v) for v in seq.frame_stamps_ns]
     box0 = [float(v) for v in seq.gt_boxes[0]]
     with tracker_and_driver(ctx, initial_box=box0, imu_wait_ms=0.0) as (node, drv):

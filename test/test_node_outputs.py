@@ -43,13 +43,18 @@ rclpy = pytest.importorskip('rclpy')
 pytest.importorskip('tf2_msgs.msg')
 pytest.importorskip('foxglove_msgs.msg')
 
-from foxglove_msgs.msg import ImageAnnotations  # noqa: E402
+from foxglove_msgs.msg import ImageAnnotations  # noqa: E402, I100
 from geometry_msgs.msg import TransformStamped  # noqa: E402
 from iemd_ros.datasets.synthetic import generate  # noqa: E402
 from iemd_ros.gyro.bearing import bearing  # noqa: E402
 from iemd_ros.gyro.camera import CameraModel  # noqa: E402
 from iemd_ros.gyro.rotation import quat_to_rot  # noqa: E402
-from iemd_ros.messages.conversions import bbox_to_box, bbox_values, stamp_ns, stamp_to_ns  # noqa: E402
+from iemd_ros.messages.conversions import (  # noqa: E402
+    bbox_to_box,
+    bbox_values,
+    stamp_ns,
+    stamp_to_ns,
+)
 from iemd_ros.pipeline import ExtrinsicSource  # noqa: E402
 from iemd_ros.ros.extrinsics import TF_STATIC_QOS  # noqa: E402
 from iemd_ros.ros.node import LifecycleTrackerNode, TrackerNode  # noqa: E402

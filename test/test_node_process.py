@@ -43,7 +43,10 @@ import pytest
 
 rclpy = pytest.importorskip('rclpy')
 pytest.importorskip('vision_msgs.msg')
-from ament_index_python.packages import get_package_prefix, PackageNotFoundError  # noqa: E402
+from ament_index_python.packages import (  # noqa: E402, I100
+    get_package_prefix,
+    PackageNotFoundError,
+)
 from iemd_ros.datasets.synthetic import generate  # noqa: E402
 from iemd_ros.messages.conversions import bbox_values, stamp_ns  # noqa: E402
 from ros_harness import child_env, Driver, isolated_ros_env, ros_context, spinning  # noqa: E402

@@ -31,6 +31,8 @@
 import math
 
 from iemd_ros.common.boxes import box_centre
+from iemd_ros.datasets.synthetic import generate
+from iemd_ros.evaluation.metrics import iou
 from iemd_ros.gyro import GyroConfig, GyroPredictor
 from iemd_ros.gyro.camera import CameraModel
 from iemd_ros.pipeline import (
@@ -42,13 +44,11 @@ from iemd_ros.pipeline import (
     TrackingPipeline,
     TrackState,
 )
+from iemd_ros.tracking import IemdTracker, TrackerConfig
 import numpy as np
 import pytest
 
 OK, WARN, ERROR = Level.OK, Level.WARN, Level.ERROR
-from iemd_ros.datasets.synthetic import generate
-from iemd_ros.evaluation.metrics import iou
-from iemd_ros.tracking import IemdTracker, TrackerConfig
 
 N = 24
 
@@ -340,8 +340,12 @@ def test_input_problem_statuses(seq):
 
 
 def test_held_frames_are_tracked_counted_and_explained(seq, monkeypatch):
-    """A frame the tracker holds (its occlusion check: the models do not learn) is still a tracked frame; it is
-    counted in ``frames_held`` and its reason reaches ``frame_reason`` and the tracking status's values."""
+    """
+    A frame the tracker holds is still a tracked frame, counted and explained.
+
+    The tracker holds a frame by its occlusion check (the models do not learn); it is counted in
+    ``frames_held`` and its reason reaches ``frame_reason`` and the tracking status's values.
+    """
     p, stamps = _started(seq)
     p.process(seq.frames[1], stamps[1])
     assert p.diagnostics()['frames_held'] == 0
@@ -411,7 +415,8 @@ def test_config_from_yaml_reads_the_node_parameter_file_nested_or_dotted(tmp_pat
     )
     ns = PipelineConfig.from_yaml(tmp_path / 'ns.yaml')
     assert (ns.tracker.n_iter, ns.imu_wait_ms, ns.use_gyro) == (12, 5.0, True)
-    # ... parameter by parameter: a group in the node's section adds to the wildcard's group, not replaces it
+    # ... parameter by parameter: a group in the node's section adds to the wildcard's group, not
+    # replaces it
     (tmp_path / 'groups.yaml').write_text(
         '/**:\n  ros__parameters:\n    tracker: {n_iter: 7, lam: 0.2}\n'
         'iemd_tracker:\n  ros__parameters:\n    tracker: {n_iter: 9}\n'

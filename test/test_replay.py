@@ -422,10 +422,10 @@ def _bag_with(
     path, *, image_topics=('/cam/image',), imu=False, bad_at=None, n=4, seq=None, empty=()
 ):
     """
-    A hand-made bag: frames of ``seq`` on each image topic.
+    Write a hand-made bag: frames of ``seq`` on each image topic but those in ``empty``.
 
-    (bgr8 Image; PNG CompressedImage on a topic ending in /compressed) but those in ``empty``,
-    optionally an IMU topic.  Frame ``bad_at`` is malformed.
+    The frames are bgr8 Images, PNG CompressedImages on a topic ending in /compressed; optionally
+    an IMU topic.  Frame ``bad_at`` is malformed.
     """
     with BagWriter(path, 'mcap') as bag:
         for t in image_topics:

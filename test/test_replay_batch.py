@@ -74,7 +74,7 @@ def folder(tmp_path_factory):
 
 @pytest.fixture(scope='module')
 def alone(folder, tmp_path_factory):
-    """Each bag's CSV and result bag from a replay of that bag alone (the serial reference)."""
+    """Return each bag's CSV and result bag from a replay of that bag by itself (the reference)."""
     d, boxes = folder
     out = tmp_path_factory.mktemp('alone')
     for name, box in zip(SIZES, boxes):

@@ -198,14 +198,16 @@ def test_installed_type_hashes_match_upstream(vm):
 
 
 def test_type_hashes_from_msg_text_with_rosidl(vm, tmp_path):
-    """rosidl's own pipeline (.msg -> .idl -> type description hash) on the repo's .msg text."""
+    """Run rosidl's pipeline (.msg -> .idl -> type description hash) on the repo's .msg text."""
     from rosidl_adapter.msg import convert_msg_to_idl
     from rosidl_generator_type_description import generate_type_hash
 
     idl_dir = tmp_path / 'idl' / 'msg'
     idl_dir.mkdir(parents=True)
     for name in TYPES:
-        convert_msg_to_idl(REPO_MSG_DIR.parent, 'vision_msgs', Path('msg') / f'{name}.msg', idl_dir)
+        convert_msg_to_idl(
+            REPO_MSG_DIR.parent, 'vision_msgs', Path('msg') / f'{name}.msg', idl_dir
+        )
     out = tmp_path / 'out'
     args = tmp_path / 'args.json'
     args.write_text(

@@ -27,11 +27,14 @@
 # ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
 # POSSIBILITY OF SUCH DAMAGE.
 
-"""``iemd-compile``: compile the tracker's and the gyro's numba kernels into numba's cache beside the installed
-package, so that the first start of the node or of ``iemd-replay`` compiles nothing.
+"""
+``iemd-compile``: compile the tracker's and the gyro's numba kernels into numba's cache.
 
-Run at install time (``scripts/setup_venv.sh``, and ``setup.py install``/``develop`` as colcon runs them); it takes
-10-30 s once per install.  Without it the first start compiles them and says so.
+The cache is beside the installed package, so that the first start of the node or of
+``iemd-replay`` compiles nothing.
+
+Run at install time (``scripts/setup_venv.sh``, and ``setup.py install``/``develop`` as colcon runs
+them); it takes 10-30 s once per install.  Without it the first start compiles them and says so.
 """
 
 from __future__ import annotations

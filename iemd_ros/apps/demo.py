@@ -136,7 +136,8 @@ def run_demo(
 
 def format_comparison(runs: dict) -> str:
     """Table: one row per mode (average overlap, success AUC, P@20, overlap > 0 / > 40 %, fps)."""
-    head = f'{"mode":<9} {"frames":>6} {"AO %":>6} {"AUC %":>6} {"P@20 %":>7} {">0 %":>6} {">40 %":>6} {"fps":>6}'
+    head = (f'{"mode":<9} {"frames":>6} {"AO %":>6} {"AUC %":>6} {"P@20 %":>7} {">0 %":>6} '
+            f'{">40 %":>6} {"fps":>6}')
     lines = [head, '-' * len(head)]
     for label, _ in MODES:
         s = runs[label][1]
@@ -151,7 +152,7 @@ def format_comparison(runs: dict) -> str:
 
 
 def plot_demo(runs: dict, gt: np.ndarray, path: Path) -> None:
-    """IoU per frame (both modes) and the OTB success curves, side by side."""
+    """Plot the IoU per frame (both modes) and the OTB success curves, side by side."""
     import matplotlib
 
     matplotlib.use('Agg')

@@ -30,10 +30,11 @@
 """
 ``iemd-eval``: one-pass evaluation of trackers on OTB-layout sequences.
 
-(:mod:`iemd_ros.evaluation.ope`).
+The evaluation is :mod:`iemd_ros.evaluation.ope`.
 
-    iemd-eval [ROOT_OR_SEQ ...] [--trackers iemd,csrt,kcf] [--sequences Car4,Bolt2] [--split train|validation]
-              [--max-frames N] [--out DIR] [--config config/tracker.yaml] [--published [FILE]]
+    iemd-eval [ROOT_OR_SEQ ...] [--trackers iemd,csrt,kcf] [--sequences Car4,Bolt2]
+              [--split train|validation] [--max-frames N] [--out DIR]
+              [--config config/tracker.yaml] [--published [FILE]]
               [--jobs N | --cluster tcp://HOST:8786]
 
 Without a folder it evaluates every sequence of ``../shared/data/otb`` and ``../shared/data/uav``.

@@ -28,11 +28,12 @@
 # POSSIBILITY OF SUCH DAMAGE.
 
 """
-``iemd-make-bag``: an image folder + IMU + calibration.
+``iemd-make-bag``: an image folder + IMU + calibration -> a bag.
 
-(CMU desk/aerial, phone, OTB layouts) -> a bag.
+The folder layouts: CMU desk/aerial, phone, OTB.
 
-    iemd-make-bag SOURCE OUT [--format mcap|sqlite3|ros1] [--compress jpeg|png] [--first N] [--count N] ...
+    iemd-make-bag SOURCE OUT [--format mcap|sqlite3|ros1] [--compress jpeg|png] [--first N]
+                  [--count N] ...
 
 What is written, stamps, clocks and frames: :mod:`iemd_ros.bags.make`.  Bad input prints one line
 on stderr and exits with status 2.

@@ -28,11 +28,12 @@
 # POSSIBILITY OF SUCH DAMAGE.
 
 """
-``iemd-make-lookaway``.
+``iemd-make-lookaway``: "look away and back" sequences cut from OTB-layout footage.
 
-"look away and back" sequences cut from OTB-layout footage, for the long-term measures.
+They are for the long-term measures.
 
-    iemd-make-lookaway [ROOT_OR_SEQ ...] --out DIR [--crop 0.5] [--follow 15] [--away 30] [--pan-px 40]
+    iemd-make-lookaway [ROOT_OR_SEQ ...] --out DIR [--crop 0.5] [--follow 15] [--away 30]
+                       [--pan-px 40]
 
 Without a folder it cuts every sequence of ``../shared/data/otb`` and ``../shared/data/uav`` whose
 target can leave the virtual camera's window (:mod:`iemd_ros.datasets.lookaway`); the others are

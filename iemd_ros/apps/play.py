@@ -30,8 +30,8 @@
 """
 ``iemd-play``: publish a bag onto ROS 2 topics with its original timing, like ``ros2 bag play``.
 
-    iemd-play BAG [--rate R] [--topics T ...] [--remap FROM:=TO ...] [--delay S] [--wait-subscribers S] [--clock]
-              [--ros-args ...]
+    iemd-play BAG [--rate R] [--topics T ...] [--remap FROM:=TO ...] [--delay S]
+              [--wait-subscribers S] [--clock] [--ros-args ...]
 
 What it publishes and how: :mod:`iemd_ros.ros.play`.  Bad input prints one line on stderr and exits
 with status 2.

@@ -28,13 +28,14 @@
 # POSSIBILITY OF SUCH DAMAGE.
 
 """
-``iemd-replay`` / ``ros2 run iemd_ros replay``.
+``iemd-replay``: run the tracker over a bag offline, as fast as the CPU allows.
 
-Run the tracker over a bag offline, as fast as the CPU allows.
+Also ``ros2 run iemd_ros replay``.
 
-    iemd-replay BAG --init X,Y,W,H [--image-topic T] [--imu-topic T] [--camera-info-topic T] [--no-gyro]
-                --csv OUT.csv [--out-bag DIR] [--video OUT.mp4] [--gt FILE] [--config YAML]
-                [--camera-yaml FILE] [--time-offset-ms MS] [--read-ahead N] [--progress | --no-progress]
+    iemd-replay BAG --init X,Y,W,H [--image-topic T] [--imu-topic T] [--camera-info-topic T]
+                [--no-gyro] --csv OUT.csv [--out-bag DIR] [--video OUT.mp4] [--gt FILE]
+                [--config YAML] [--camera-yaml FILE] [--time-offset-ms MS] [--read-ahead N]
+                [--progress | --no-progress]
     iemd-replay BAG_OR_FOLDER [...] --init X,Y,W,H [--init ...] --out-dir DIR [--out-bags]
                 [--jobs N | --cluster tcp://HOST:8786] [the topic, gyro and config options]
 
@@ -96,7 +97,7 @@ def score_replay(result: ReplayResult, gt: np.ndarray, name: str) -> SequenceSco
 def evaluation_table(
     result: ReplayResult, gt: np.ndarray, name: str, label: str = 'iemd'
 ) -> tuple[str, object]:
-    """Scores of the replay against ``gt`` and the table of :func:`iemd_ros.evaluation.ope.format_table`."""
+    """Return the scores of the replay against ``gt`` and their table (``format_table``)."""
     scores = score_replay(result, gt, name)
     table = format_table(
         {label: {name: scores.to_dict(), MEAN: mean_scores([scores])}}, [label], [name]

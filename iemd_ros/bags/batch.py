@@ -170,9 +170,9 @@ class ReplayJob:
 
 def _no_warning(text: str) -> None:
     """
-    A replay job keeps its warnings in its result.
+    Keep a replay job's warnings in its result, for the command to print.
 
-    (``ReplayResult.warnings``) for the command to print.
+    They go to ``ReplayResult.warnings``.
     """
 
 

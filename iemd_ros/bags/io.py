@@ -119,12 +119,16 @@ def ros2_typestore():
 
 
 def ros1_typestore():
-    """ROS 1 Noetic typestore (Image, Imu, CameraInfo with ``D``/``K``/``R``/``P`` and ``Header.seq``).
+    """
+    Return the ROS 1 Noetic typestore.
+
+    It has Image, Imu, CameraInfo with ``D``/``K``/``R``/``P`` and ``Header.seq``.
 
     Returns
     -------
     rosbags.typesys.store.Typestore
         The typestore.
+
     """
     from rosbags.typesys import get_typestore, Stores
 
@@ -343,7 +347,9 @@ def header(bag: BagWriter, topic: str, stamp_ns: int, frame_id: str):
 
 def camera_info_fields(ros1: bool, d, k, r, p) -> dict:
     """
-    CameraInfo matrix fields under their ROS 1 (``D K R P``) or ROS 2 (``d k r p``) names.
+    Return the CameraInfo matrix fields under their ROS 1 (``D K R P``) or ROS 2 names.
+
+    The ROS 2 names are ``d k r p``.
 
     Parameters
     ----------

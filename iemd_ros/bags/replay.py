@@ -196,7 +196,7 @@ class ReplayResult:
 
     @property
     def gyro_used(self) -> int:
-        """Number of frames tracked with the gyro prior."""
+        """Return number of frames tracked with the gyro prior."""
         return sum(r.gyro_used for r in self.results)
 
 
@@ -299,9 +299,9 @@ class _OutBag:
         self, log_t: int, frame_id: str, r: FrameResult, statuses, image: np.ndarray | None
     ) -> None:
         """
-        The frame's Detection2DArray (one detection while ``r`` is tracking, else empty).
+        Write the frame's Detection2DArray (one detection while ``r`` is tracking, else empty).
 
-        Its annotations, its drawing (when the frame decoded) and its statuses.
+        Also its annotations, its drawing (when the frame decoded) and its statuses.
         """
         hdr = header(self.make, r.stamp_ns, frame_id)
         self.bag.write(

@@ -52,7 +52,10 @@ class UsageError(Exception):
 
 
 class CliParser(argparse.ArgumentParser):
-    """``argparse.ArgumentParser`` whose errors raise :class:`UsageError` instead of printing the usage and exiting.
+    """
+    ``argparse.ArgumentParser`` whose errors raise :class:`UsageError`.
+
+    It does not print the usage and exit.
 
     It takes the parameters of :class:`argparse.ArgumentParser`.
     """

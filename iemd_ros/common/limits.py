@@ -39,8 +39,10 @@ sizes, the camera matrix, target boxes. They are checked where a message becomes
 absurd or non-finite value reaches OpenCV or numba; docs/parameters.md lists them (generated,
 :func:`iemd_ros.ros.parameters.parameter_table`), docs/decisions.md#input-limits says why::
 
-    IMAGE_SIDE.check("image width", 100_000)               # ValueError: image width = 100000 px is out of [2, ...
-    FOCAL_LENGTH.check("camera_info k[0] (fx)", 1e8, 640)  # the range scaled by the image's larger side
+    # ValueError: image width = 100000 px is out of [2, ...
+    IMAGE_SIDE.check("image width", 100_000)
+    # the range scaled by the image's larger side
+    FOCAL_LENGTH.check("camera_info k[0] (fx)", 1e8, 640)
 """
 from __future__ import annotations
 
@@ -137,7 +139,7 @@ class Limit:
 
     @property
     def text(self) -> str:
-        """The range as the docs' table writes it."""
+        """Return the range as the docs' table writes it."""
         unit = f' x the {self.per}' if self.per else ' px'
         return f'[{number_text(self.low)}, {number_text(self.high)}]{unit}'
 

@@ -71,8 +71,9 @@ __all__ = [
 
 #: jobs kept submitted per local worker process (one running, one queued in the pool)
 WINDOW_PER_WORKER = 2
-#: Dask configuration for the nannies that start a cluster's workers: no ``MALLOC_TRIM_THRESHOLD_`` (Dask's default
-#: sets it, which turns every image-sized temporary into an mmap and its page faults; docs/decisions.md#parallel-engine)
+#: Dask configuration for the nannies that start a cluster's workers: no ``MALLOC_TRIM_THRESHOLD_``
+#: (Dask's default sets it, which turns every image-sized temporary into an mmap and its page
+#: faults; docs/decisions.md#parallel-engine)
 DASK_WORKER_CONFIG = {'distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_': None}
 
 
@@ -223,7 +224,7 @@ class InlineExecutor(Executor):
 
 @contextmanager
 def _executor(workers: Workers, n_jobs: int) -> Iterator[tuple[Executor, int]]:
-    """The executor of ``workers`` for ``n_jobs`` jobs and how many jobs to keep submitted to it."""
+    """Return the executor of ``workers`` for ``n_jobs`` jobs and how many to keep submitted."""
     if workers.cluster is not None:
         from distributed import Client
 

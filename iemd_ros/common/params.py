@@ -36,7 +36,8 @@ A configuration is a dataclass whose fields are made with :func:`param`::
 
     @dataclass
     class TrackerConfig:
-        n_iter: int = param(20, "maximum descent iterations per start", range=(0, 500), eq="Algorithm 1")
+        n_iter: int = param(20, "maximum descent iterations per start", range=(0, 500),
+                            eq="Algorithm 1")
 
         def __post_init__(self):
             coerce(self)       # types and ranges of every field, from its Spec
@@ -95,7 +96,7 @@ class Spec:
 
     doc: str
     unit: str = ''
-    range: tuple[float, float] | None = None
+    range: tuple[float, float] | None = None  # noqa: A003 (the declarations' keyword)
     length: int | None = None
     eq: str = ''
     decision: str = ''

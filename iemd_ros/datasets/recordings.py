@@ -310,7 +310,10 @@ def load_cmu(root) -> Recording:
 
 
 def load_phone(root) -> Recording:
-    """Load the phone sequence (``derived_frames.csv``, ``derived_gyro_camframe.csv``, ``derived_camera.yaml``).
+    """
+    Load the phone sequence.
+
+    Its files: ``derived_frames.csv``, ``derived_gyro_camframe.csv``, ``derived_camera.yaml``.
 
     Parameters
     ----------
@@ -326,6 +329,7 @@ def load_phone(root) -> Recording:
     ------
     ValueError
         For a missing file or a calibration that cannot be read.
+
     """
     import yaml
 

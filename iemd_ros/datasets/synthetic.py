@@ -250,7 +250,7 @@ class SyntheticSequence:
 
     @cached_property
     def camera(self) -> CameraModel:
-        """The camera model of the sequence (K, lens and image size)."""
+        """Return the camera model of the sequence (K, lens and image size)."""
         return CameraModel(self.K, self.dist, self.config.width, self.config.height, 'synthetic')
 
     def relative_rotation(self, k: int) -> np.ndarray:

@@ -31,10 +31,10 @@
 Tracking metrics of the OTB protocol (Wu, Lim & Yang 2013) used in the paper's evaluation.
 
 Boxes are ``(x, y, w, h)`` in 0-based continuous pixel coordinates (top-left corner + size).  The
-paper's measure is the relative overlap ``|R_tr ∩ R_gt| / |R_tr ∪ R_gt|`` (Section "Experiments",
-overlap equation); its tables report the average overlap, the gyro experiment also the fraction of
-frames with overlap > 0 and > 40 %.  The OTB success plot / AUC and precision@20px are added so the
-figures compare with the rest of the field.
+paper's measure is the relative overlap ``|R_tr ∩ R_gt| / |R_tr ∪ R_gt|`` (Section
+"Experiments", overlap equation); its tables report the average overlap, the gyro experiment also
+the fraction of frames with overlap > 0 and > 40 %.  The OTB success plot / AUC and precision@20px
+are added so the figures compare with the rest of the field.
 
 All fractions are returned in [0, 1]; callers multiply by 100 for percentages.
 
@@ -406,7 +406,8 @@ def score_sequence(
 
 #: A return counts as re-acquired once a reported box overlaps the target by at least this IoU.
 REACQUIRED_IOU = 0.3
-#: ... within this many frames of the target's return (the issue's "back on the target within 30 frames").
+#: ... within this many frames of the target's return (the issue's "back on the target within 30
+#: frames").
 REACQUIRE_WITHIN = 30
 
 

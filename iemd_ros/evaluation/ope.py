@@ -252,8 +252,8 @@ def _opencv_factory(kind: str) -> Callable[..., OpenCVTracker]:
     return factory
 
 
-#: name -> factory returning a fresh :class:`TrackerAdapter` with its defaults, or with ``factory(config)``
-#: for a tracker that has a configuration (iEMD: a TrackerConfig).
+#: name -> factory returning a fresh :class:`TrackerAdapter` with its defaults, or with
+#: ``factory(config)`` for a tracker that has a configuration (iEMD: a TrackerConfig).
 TRACKERS: dict[str, Callable[..., TrackerAdapter]] = {
     'iemd': IemdAdapter,
     'csrt': _opencv_factory('CSRT'),
@@ -514,7 +514,8 @@ def format_long_term(doc: dict) -> str:
     names = [n for n in doc['sequences'] if 'long_term' in doc['results'][trackers[0]][n]]
     if not names:
         return ''
-    header = f'{"sequence":<14} {"tracker":<7} {"P%":>6} {"R%":>6} {"F%":>6} {"reports on absent%":>19} {"back":>6}'
+    header = (f'{"sequence":<14} {"tracker":<7} {"P%":>6} {"R%":>6} {"F%":>6} '
+              f'{"reports on absent%":>19} {"back":>6}')
     lines = ['long-term measures (the target leaves the view):', header, '-' * len(header)]
 
     def row(label: str, trk: str, s: dict) -> str:
@@ -590,7 +591,8 @@ def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
         The table, fractions in percent.
 
     """
-    header = f'{"sequence":<14} {"tracker":<7} {"frames":>6} {"AO%":>6} {"AUC%":>6} {"P@20%":>6} {">0%":>6} {">40%":>6} {"fps":>8}'
+    header = (f'{"sequence":<14} {"tracker":<7} {"frames":>6} {"AO%":>6} {"AUC%":>6} {"P@20%":>6} '
+              f'{">0%":>6} {">40%":>6} {"fps":>8}')
     lines = [header, '-' * len(header)]
 
     def row(label: str, trk: str, s: dict, n: int) -> str:

@@ -151,7 +151,7 @@ class CameraModel:
             )
 
     def _check_intrinsics(self, width: int, height: int) -> None:
-        """ValueError naming the entry of K out of its limit for ``width`` x ``height`` images."""
+        """Raise ValueError naming the entry of K out of its limit for ``width`` x ``height``."""
         K = self.K
         side = max(width, height)
         FOCAL_LENGTH.check('camera_info k[0] (fx)', K[0, 0], side)

@@ -39,7 +39,7 @@ as tf2's ``lookup_transform(target, source)`` does; the gyro prior wants ``R_cam
 rotation(camera frame, IMU frame)`` (``w_cam = R_cam_imu w_imu``)::
 
     frames = StaticFrames()
-    frames.add("base_link", "imu_link", (0, 0, 0, 1))                         # x, y, z, w as in ROS
+    frames.add("base_link", "imu_link", (0, 0, 0, 1))  # x, y, z, w as in ROS
     frames.add("base_link", "camera_optical_frame", (-0.5, 0.5, -0.5, 0.5))
     R_cam_imu = frames.rotation("camera_optical_frame", "imu_link")
 """

@@ -119,12 +119,12 @@ class ImuIntegration:
 
     @property
     def covered(self) -> bool:
-        """True when ``R`` was integrated from data (status ``ok`` or ``gap``)."""
+        """Return True when ``R`` was integrated from data (status ``ok`` or ``gap``)."""
         return self.status in (Coverage.OK, Coverage.GAP)
 
     @property
     def ok(self) -> bool:
-        """True when the window is covered without a gap (status ``ok``)."""
+        """Return True when the window is covered without a gap (status ``ok``)."""
         return self.status is Coverage.OK
 
 
@@ -176,7 +176,7 @@ class ImuBuffer:
         self._t_max: int | None = None         # largest stamp ever accepted
         self._t_integrated: int | None = None  # largest window end integrated so far
         self.counts = {'added': 0, 'accepted': 0, 'nan': 0, 'saturated': 0, 'duplicates': 0,
-                           'out_of_order': 0, 'late': 0, 'dropped': 0}
+                       'out_of_order': 0, 'late': 0, 'dropped': 0}
 
     @staticmethod
     def check_settings(max_duration_ns, max_samples, saturation, max_gap_ns) -> None:
@@ -502,7 +502,10 @@ class ImuBuffer:
 
 @numba.njit(cache=True)
 def _window_rotation(rel, ws, t_end, coning):
-    """Quaternion of :func:`iemd_ros.gyro.rotation.integrate_rates` over [0, t_end] for samples at ``rel``.
+    """
+    Return the quaternion of :func:`iemd_ros.gyro.rotation.integrate_rates` over [0, t_end].
+
+    The samples are at ``rel``.
 
     ``rel`` (s, strictly increasing) brackets the window: rel[0] <= 0 < t_end <= rel[-1], so it
     holds at least 2 samples (``integrate`` answers an empty window before calling).  The knots are

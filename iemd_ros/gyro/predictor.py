@@ -372,7 +372,7 @@ class GyroPrediction:
 
     @property
     def status(self) -> Coverage:
-        """The integration's coverage status."""
+        """Return the integration's coverage status."""
         return self.integration.status
 
 
@@ -413,7 +413,7 @@ class GyroPredictor:
 
     @property
     def calibration(self) -> GyroCalibration:
-        """Current extrinsic + bias (the still-start estimate once available)."""
+        """Return current extrinsic + bias (the still-start estimate once available)."""
         return self._cal
 
     def add_imu(self, t_ns, w) -> np.ndarray:

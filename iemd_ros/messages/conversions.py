@@ -34,9 +34,11 @@ The functions read message fields by name and never import a message type, so ``
 (``data`` is an ``array.array`` or ``bytes``), ``rosbags`` messages (``data`` is a numpy array) and
 hand-made values all work:
 
-    frame = image_from_msg(msg)                  # an Image (image_to_array) or a CompressedImage (compressed_to_array)
-    t_ns, gyro, cov0 = imu_sample(msg)           # the arguments of TrackingPipeline.add_imu_message
-    camera = camera_model_from_msg(msg)          # CameraInfo, cached per content (ROS 1 or 2 field names)
+    frame = image_from_msg(msg)                  # an Image (image_to_array) or a CompressedImage
+                                                 # (compressed_to_array)
+    t_ns, gyro, cov0 = imu_sample(msg)           # the arguments of add_imu_message
+    camera = camera_model_from_msg(msg)          # CameraInfo, cached per content (ROS 1 or 2
+                                                 # field names)
     fill_image_msg(Image(), frame)               # a frame into an Image's pixel fields
     values = detection_values(result)            # a FrameResult's Detection2D values (or None)
 
@@ -185,7 +187,11 @@ def image_to_array(
 
 
 def _check_size(width: int, height: int) -> None:
-    """ValueError unless the image's width and height are within :data:`~iemd_ros.common.limits.IMAGE_SIDE`."""
+    """
+    Raise ValueError unless the image's width and height are within the limits.
+
+    The limits are :data:`~iemd_ros.common.limits.IMAGE_SIDE`.
+    """
     IMAGE_SIDE.check('image width', width)
     IMAGE_SIDE.check('image height', height)
 
@@ -398,9 +404,11 @@ def raw_twin(topic: str) -> str | None:
 def array_to_compressed_fields(
     frame: np.ndarray, codec: str = 'jpeg', quality: int = JPEG_QUALITY
 ) -> dict:
-    """Tracker frame -> ``sensor_msgs/CompressedImage`` fields as image_transport's compressed plugin writes them.
+    """
+    Tracker frame -> ``sensor_msgs/CompressedImage`` fields.
 
-    ``format`` is ``"bgr8; jpeg compressed bgr8"``, for ``HxW`` ``"mono8; jpeg compressed "`` (the plugin names a target
+    The fields are as image_transport's compressed plugin writes them.  ``format`` is ``"bgr8; jpeg
+    compressed bgr8"``, for ``HxW`` ``"mono8; jpeg compressed "`` (the plugin names a target
     encoding for colour only; ``png`` is lossless).
 
     Parameters
@@ -421,6 +429,7 @@ def array_to_compressed_fields(
     ------
     ValueError
         For a bad frame, codec or quality, or a frame OpenCV cannot encode.
+
     """
     frame = _check_frame(frame)
     check_compression(codec, quality)
@@ -663,9 +672,11 @@ def ns_to_stamp(t_ns: int) -> tuple[int, int]:
 
 
 def box_to_bbox(box) -> tuple[float, float, float, float]:
-    """Tracker box ``(x, y, w, h)`` -> ``vision_msgs/BoundingBox2D`` ``(center_x, center_y, size_x, size_y)``.
+    """
+    Tracker box ``(x, y, w, h)`` -> ``vision_msgs/BoundingBox2D``.
 
-    The centre is in pixel-index coordinates (pixel centres at integers, as ``K``): ``x + (w - 1) / 2``
+    The BoundingBox2D is ``(center_x, center_y, size_x, size_y)``.  The centre is in pixel-index
+    coordinates (pixel centres at integers, as ``K``): ``x + (w - 1) / 2``
     (:func:`iemd_ros.common.boxes.box_centre`); the size is ``w, h`` pixels.
 
     Parameters
@@ -682,6 +693,7 @@ def box_to_bbox(box) -> tuple[float, float, float, float]:
     ------
     ValueError
         For a box that is not finite with a positive size.
+
     """
     b = check_box(box)
     cx, cy = box_centre(b)

@@ -70,7 +70,7 @@ class MessageFactory(Protocol):
 
     def byte(self, value: int):
         """
-        The value of a ``byte`` field.
+        Return the value of a ``byte`` field.
 
         Parameters
         ----------
@@ -176,11 +176,13 @@ def detection_array(make: MessageFactory, hdr, results, class_id: str, default_i
 
 
 def bearing_array(make: MessageFactory, hdr, results, camera, class_id: str, default_id: str):
-    """The bearings of one frame's targets as a ``vision_msgs/Detection3DArray`` in the camera's optical frame.
+    """
+    Return the bearings of one frame's targets as a ``vision_msgs/Detection3DArray``.
 
-    Each detection is the target seen as if at 1 m along its ray (:mod:`iemd_ros.gyro.bearing`): ``bbox.center``
-    has the unit ray as its position and, as its orientation, the shortest rotation of the optical axis onto the ray;
-    ``bbox.size`` is ``(2 tan(angular_width / 2), 2 tan(angular_height / 2), 0)``, the size at that range; the
+    The array is in the camera's optical frame.  Each detection is the target seen as if at 1 m
+    along its ray (:mod:`iemd_ros.gyro.bearing`): ``bbox.center`` has the unit ray as its position
+    and, as its orientation, the shortest rotation of the optical axis onto the ray; ``bbox.size``
+    is ``(2 tan(angular_width / 2), 2 tan(angular_height / 2), 0)``, the size at that range; the
     hypothesis carries the class, the score and the same pose.
 
     Parameters
@@ -202,6 +204,7 @@ def bearing_array(make: MessageFactory, hdr, results, camera, class_id: str, def
     -------
     vision_msgs/Detection3DArray
         One detection per tracking target whose box lies in the lens model's valid region.
+
     """
     detections = []
     for result in results if camera is not None else ():

@@ -57,7 +57,7 @@ class ImuWait:
 
     @property
     def wait_ns(self) -> int:
-        """The longest wait, ns (the pipeline's ``imu_wait_ms``)."""
+        """Return the longest wait, ns (the pipeline's ``imu_wait_ms``)."""
         return int(round(self._pipeline.config.imu_wait_ms * 1e6))
 
     def ready(self, stamp_ns: int) -> bool:

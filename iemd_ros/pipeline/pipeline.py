@@ -35,7 +35,7 @@ The one place where per-message data flows into :class:`~iemd_ros.tracking.IemdT
 (:mod:`iemd_ros.bags.replay`) both feed it, so they produce the same boxes from the same messages::
 
     pipe = TrackingPipeline(PipelineConfig())
-    pipe.set_camera(camera)                      # from CameraInfo (messages.conversions.camera_model_from_msg)
+    pipe.set_camera(camera)                      # from CameraInfo (camera_model_from_msg)
     pipe.add_imu(t_ns, (wx, wy, wz))             # every Imu message (IMU frame, rad/s)
     pipe.init(frame, (x, y, w, h), t_ns)         # start (or restart) on a frame: its FrameResult
     result = pipe.process(frame, t_ns)           # FrameResult, once ImuWait lets the frame go
@@ -163,11 +163,12 @@ class _Target:
         self.last_result: FrameResult | None = None
 
     def restart(self, config) -> None:
-        """A new tracker at the window it holds, on the frame that window belongs to."""
+        """Restart the tracker at the window it holds, on the frame that window belongs to."""
         _, box, frame = self.ref
         self.tracker = IemdTracker(config)
         self.tracker.init(frame, box)
-        self.state, self.lost_run, self.lost_since, self.window = TrackState.TRACKING, 0, None, self.ref[:2]
+        self.state, self.lost_run, self.lost_since, self.window = (
+            TrackState.TRACKING, 0, None, self.ref[:2])
 
 
 class TrackingPipeline:
@@ -252,13 +253,15 @@ class TrackingPipeline:
     # ------------------------------------------------------------------ configuration
     @property
     def config(self) -> PipelineConfig:
-        """The current configuration."""
+        """Return the current configuration."""
         return self._cfg
 
     @property
     def state(self) -> TrackState:
         """
-        The tracking state: uninitialized without a target, tracking while any target is tracked.
+        Return the tracking state.
+
+        Uninitialized without a target, tracking while any target is tracked.
 
         Else lost.
         """
@@ -273,7 +276,7 @@ class TrackingPipeline:
 
     @property
     def targets(self) -> list[str]:
-        """The ids of the targets, in the order they were added."""
+        """Return the ids of the targets, in the order they were added."""
         with self._lock:
             return list(self._targets)
 
@@ -298,7 +301,7 @@ class TrackingPipeline:
 
     @property
     def camera(self) -> CameraModel | None:
-        """The camera model of the gyro prior (None until one is set)."""
+        """Return the camera model of the gyro prior (None until one is set)."""
         return self._predictor.camera
 
     def configure(self, config: PipelineConfig) -> str:
@@ -395,7 +398,11 @@ class TrackingPipeline:
             self._last['camera_error'] = reason
 
     def _rebuild_predictor(self) -> None:
-        """New GyroPredictor for the current gyro config, fed the samples buffered so far."""
+        """
+        Build a new GyroPredictor for the current gyro config.
+
+        Fed the samples buffered so far.
+        """
         t, w = self._predictor.buffer.samples()
         self._predictor = self._new_predictor()
         if len(t):
@@ -900,7 +907,8 @@ class TrackingPipeline:
             )
         else:
             tracker = target.tracker
-            reason = f'tracker update {exc} (watchdog_ms {self._cfg.watchdog_ms:g} ms): frame not tracked'
+            reason = (f'tracker update {exc} (watchdog_ms {self._cfg.watchdog_ms:g} ms): '
+                      'frame not tracked')
         with self._lock:
             target.tracker = tracker
             self.counters['updates_abandoned'] += exc.ran
@@ -915,7 +923,11 @@ class TrackingPipeline:
             )
 
     def _check_stamp(self, t: int) -> str:
-        """ "" if a frame stamped ``t`` can be processed, else why not (handles clock resets)."""
+        """
+        Return "" if a frame stamped ``t`` can be processed.
+
+        Else why not (handles clock resets).
+        """
         last = self._last_stamp
         if last is None or t > last:
             return ''

@@ -113,7 +113,7 @@ class Watchdog:
 
     def run(self, call, timeout_s: float):
         """
-        ``call()``'s result, or :class:`Abandoned` once it has run for ``timeout_s``.
+        Return ``call()``'s result, or :class:`Abandoned` once it has run for ``timeout_s``.
 
         Parameters
         ----------

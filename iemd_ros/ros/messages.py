@@ -43,7 +43,7 @@ __all__ = ['message_class', 'RclpyMessages', 'RCLPY_MESSAGES']
 @lru_cache(maxsize=None)
 def message_class(msgtype: str):
     """
-    rclpy message class of ``pkg/msg/Name`` (from the installed message package).
+    Return the rclpy message class of ``pkg/msg/Name`` (from the installed message package).
 
     ValueError when that package is not installed.
     """

@@ -264,7 +264,8 @@ class _Tracker:
             f'(gyro {"on" if cfg.use_gyro else "off"}, '
             f'{"reliable" if node.reliable_qos else "sensor-data"} '
             f'QoS, camera-IMU rotation from {self._extrinsics.backend} or gyro.R_cam_imu); '
-            f'{"initial box " + str(self._initial_box) if self._initial_box else "waiting for ~/init"}'
+            + ('initial box ' + str(self._initial_box) if self._initial_box
+               else 'waiting for ~/init')
         )
 
     def _shut(self, destroy_publisher) -> None:
@@ -582,8 +583,12 @@ class _Tracker:
         return results
 
     def _update_extrinsic(self, camera_frame: str) -> None:
-        """The camera-IMU rotation from TF between the latest IMU message's frame and this image's frame (the
-        parameter when the frames are one, unnamed, or no transform is known)."""
+        """
+        Update the camera-IMU rotation from TF.
+
+        It is the rotation between the latest IMU message's frame and this image's frame (the
+        parameter when the frames are one, unnamed, or no transform is known).
+        """
         imu_frame = self._imu_frame
         R = None
         if imu_frame and camera_frame and imu_frame.lstrip('/') != camera_frame.lstrip('/'):
@@ -620,9 +625,9 @@ class _Tracker:
     # ------------------------------------------------------------------ output
     def _publish(self, img: Image | CompressedImage, results: list, received) -> None:
         """
-        The image's Detection2DArray (one detection per tracked target).
+        Publish the image's Detection2DArray (one detection per tracked target).
 
-        Its bearings and annotations.
+        Also its bearings and annotations.
         """
         cfg = self._node_cfg
         results = [r for r in results if r is not None]
@@ -750,7 +755,8 @@ class _Tracker:
         since = now - busy[0]
         if since <= (cfg.imu_wait_ms + 2 * cfg.watchdog_ms) / 1e3:
             return ''
-        return f'the tracking worker has been on the frame stamped {busy[1]} ns for {since:.1f} s (stuck?)'
+        return (f'the tracking worker has been on the frame stamped {busy[1]} ns for {since:.1f} '
+                's (stuck?)')
 
     def _publish_diagnostics(self) -> None:
         hdr = header(RCLPY_MESSAGES, self.get_clock().now().nanoseconds, '')

@@ -30,7 +30,7 @@
 """
 The node's ROS parameters, all made from the declarations of the configurations.
 
-(:mod:`iemd_ros.common.params`).
+The declarations are those of :mod:`iemd_ros.common.params`.
 
 Every parameter is declared once: the pipeline's (``use_gyro``, ...), its groups' (``tracker.*``,
 ``gyro.*``) and the node's own (:class:`NodeConfig`).  From those come the node's parameter
@@ -76,7 +76,7 @@ class ImageTransport(Choice):
 
 @dataclass
 class NodeConfig:
-    """The node's own parameters (the pipeline's are :class:`~iemd_ros.pipeline.PipelineConfig`)."""
+    """The node's own parameters (the pipeline's: :class:`~iemd_ros.pipeline.PipelineConfig`)."""
 
     initial_box: tuple[float, ...] = param(
         (),

@@ -30,7 +30,8 @@
 """
 ``iemd-play``: publish a bag onto ROS 2 topics with its original timing, like ``ros2 bag play``.
 
-    iemd-play BAG [--rate R] [--topics T ...] [--remap FROM:=TO ...] [--delay S] [--wait-subscribers S] [--clock]
+    iemd-play BAG [--rate R] [--topics T ...] [--remap FROM:=TO ...] [--delay S]
+              [--wait-subscribers S] [--clock]
               [--ros-args ...]
 
 rosbag2's player is not installable from PyPI, so this is a small one in rclpy: each message is
@@ -70,7 +71,11 @@ class PlayStats:
 
 
 def _cdr_converter(reader, msgtype: str, cache: dict, dst_typestore):
-    """bytes of the bag -> ROS 2 CDR bytes (identity for rosbag2, rosbags' converter for ROS 1)."""
+    """
+    Return the converter of the bag's bytes to ROS 2 CDR bytes.
+
+    The identity for rosbag2, rosbags' converter for ROS 1.
+    """
     if reader.is2:
         return bytes
     from rosbags.convert.converter import generate_message_converter
@@ -116,6 +121,10 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
     node : rclpy node, optional
         Where to create the publishers (default: a new ``iemd_play`` node; rclpy is initialised if
         needed, with ``ros_args``, and shut down again).
+    progress : bool or None, optional
+        A progress bar on stderr (None: only when stderr is a terminal).
+    ros_args : list of str, optional
+        The ROS arguments rclpy is initialised with, when this function initialises it.
 
     Returns
     -------
