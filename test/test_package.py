@@ -76,9 +76,13 @@ def test_manifest_is_a_valid_format_3_ament_python_package():
     package.validate()  # raises InvalidPackage, e.g. for a maintainer email catkin_pkg rejects
     assert package.package_format == 3 and package.name == 'iemd_ros'
     assert package.get_build_type() == 'ament_python'
-    setup_py = (REPO / 'setup.py').read_text()
-    assert f'version="{package.version}"' in setup_py
-    assert f'maintainer_email="{package.maintainers[0].email}"' in setup_py
+    setup_call = next(node for node in ast.walk(ast.parse((REPO / 'setup.py').read_text()))
+                      if isinstance(node, ast.Call) and getattr(node.func, 'id', None) == 'setup')
+    keywords = {
+        k.arg: k.value.value for k in setup_call.keywords if isinstance(k.value, ast.Constant)
+    }
+    assert keywords['version'] == package.version
+    assert keywords['maintainer_email'] == package.maintainers[0].email
 
 
 def test_every_imported_module_is_declared():
