@@ -1,5 +1,37 @@
 #!/usr/bin/env python3
-"""Robustness to the initial box: average overlap from shifted starts, iEMD against CSRT in the same run.
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
+"""
+Robustness to the initial box.
+
+Average overlap from shifted starts, iEMD against CSRT in the same run.
 
     python benchmarks/perturbed_starts.py [--sequences Car4,Bolt2] [--shift 0.1] [--starts sre] \
         [--config "{}" --config "{'alpha': 0.4}"] [--jobs 2]
@@ -8,11 +40,11 @@ OTB's one-pass evaluation starts every tracker from the exact ground truth, and 
 tracker whose result swings with small changes says little.  As OTB's spatial robustness evaluation
 (SRE) does, every sequence is also started from the ground truth shifted by ``shift`` of its size
 along the four diagonals (5 starts in all); with ``--starts sre`` also along the four axes and with
-the box scaled by 0.8, 0.9, 1.1 and 1.2 about its centre (13 starts: OTB's 8 spatial shifts and 4 scale
-variations, and the ground truth).  Each run is scored over all its frames against the ground truth
-(iemd_ros.evaluation.metrics).  Printed per tracker: the mean average overlap over sequences and
-starts, its mean per start, per sequence, and the median update time.  ``--config`` runs iEMD with
-other TrackerConfig values (default: the defaults), each against the same peers.
+the box scaled by 0.8, 0.9, 1.1 and 1.2 about its centre (13 starts: OTB's 8 spatial shifts and 4
+scale variations, and the ground truth).  Each run is scored over all its frames against the ground
+truth (iemd_ros.evaluation.metrics).  Printed per tracker: the mean average overlap over sequences
+and starts, its mean per start, per sequence, and the median update time.  ``--config`` runs iEMD
+with other TrackerConfig values (default: the defaults), each against the same peers.
 """
 from __future__ import annotations
 
@@ -20,30 +52,45 @@ import argparse
 import ast
 from multiprocessing import Pool
 
-import numpy as np
-
 from iemd_ros import TrackerConfig
 from iemd_ros.common.boxes import box_centre, centre_box
-from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
-from iemd_ros.evaluation.metrics import score_sequence
 from iemd_ros.datasets.otb import load_sequence
+from iemd_ros.evaluation.metrics import score_sequence
+from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.split import PARTS, split_names
+import numpy as np
 
-# Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, and the box's scale.
-DIAGONALS = ((0.0, 0.0, 1.0), (1.0, 1.0, 1.0), (-1.0, 1.0, 1.0), (1.0, -1.0, 1.0), (-1.0, -1.0, 1.0))
+# Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, and the box's
+# scale.
+DIAGONALS = (
+    (0.0, 0.0, 1.0),
+    (1.0, 1.0, 1.0),
+    (-1.0, 1.0, 1.0),
+    (1.0, -1.0, 1.0),
+    (-1.0, -1.0, 1.0),
+)
 AXES = ((1.0, 0.0, 1.0), (-1.0, 0.0, 1.0), (0.0, 1.0, 1.0), (0.0, -1.0, 1.0))
 SCALES = tuple((0.0, 0.0, s) for s in (0.8, 0.9, 1.1, 1.2))
-START_SETS = {"diagonal": DIAGONALS, "sre": DIAGONALS + AXES + SCALES}
+START_SETS = {'diagonal': DIAGONALS, 'sre': DIAGONALS + AXES + SCALES}
 
 
 def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: float) -> np.ndarray:
-    """The box (x, y, w, h) ``first`` with its centre moved by (dx, dy) x ``shift`` x its size, then scaled by
-    ``scale`` about that centre."""
-    return centre_box(box_centre(first) + np.array([dx, dy]) * shift * first[2:], first[2:] * scale)
+    """
+    Return the box (x, y, w, h) ``first`` with its centre moved by (dx, dy) x ``shift`` x its size.
+
+    Then scaled by ``scale`` about that centre.
+    """
+    return centre_box(
+        box_centre(first) + np.array([dx, dy]) * shift * first[2:], first[2:] * scale
+    )
 
 
 def run(job):
-    """[(average overlap, median update ms) per start] of each run on one sequence, decoded once."""
+    """
+    [(average overlap, median update ms) per start] of each run on one sequence.
+
+    Decoded once.
+    """
     name, runs, shift, starts = job
     seq = load_sequence(name)
     frames = list(seq.frames())
@@ -62,45 +109,83 @@ def run(job):
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--sequences", default=None,
-                        help="comma-separated (default: all in ../shared/data/otb and ../shared/data/uav)")
-    parser.add_argument("--split", choices=PARTS, default=None, help="only this part of the fixed split")
-    parser.add_argument("--peers", default="csrt", help="comma-separated OpenCV peers (default: csrt)")
-    parser.add_argument("--config", action="append", help="iEMD TrackerConfig values as a Python dict (repeatable)")
-    parser.add_argument("--shift", type=float, default=0.1, help="start shift, fraction of the box size")
-    parser.add_argument("--starts", choices=sorted(START_SETS), default="diagonal",
-                        help="diagonal: the ground truth and 4 diagonal shifts; sre: also 4 axis shifts, 4 scales")
-    parser.add_argument("--jobs", type=int, default=2)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        '--sequences',
+        default=None,
+        help='comma-separated (default: all in ../shared/data/otb and ../shared/data/uav)',
+    )
+    parser.add_argument(
+        '--split', choices=PARTS, default=None, help='only this part of the fixed split'
+    )
+    parser.add_argument(
+        '--peers', default='csrt', help='comma-separated OpenCV peers (default: csrt)'
+    )
+    parser.add_argument(
+        '--config', action='append', help='iEMD TrackerConfig values as a Python dict (repeatable)'
+    )
+    parser.add_argument(
+        '--shift', type=float, default=0.1, help='start shift, fraction of the box size'
+    )
+    parser.add_argument(
+        '--starts',
+        choices=sorted(START_SETS),
+        default='diagonal',
+        help='diagonal: the ground truth and 4 diagonal shifts; sre: also 4 axis shifts, 4 scales',
+    )
+    parser.add_argument('--jobs', type=int, default=2)
     args = parser.parse_args()
     names = sequence_names(args.sequences)
     if args.split is not None:
         names = [n for n in names if n in split_names(args.split)]
     # Checked here, before any run: a bad key or peer fails at once with its own message.
-    runs = [(f"iemd {c}" if args.config else "iemd", "iemd", TrackerConfig.from_dict(ast.literal_eval(c)))
-            for c in (args.config or ["{}"])]
-    peers = [peer for peer in args.peers.split(",") if peer]
+    runs = [
+        (
+            f'iemd {c}' if args.config else 'iemd',
+            'iemd',
+            TrackerConfig.from_dict(ast.literal_eval(c)),
+        )
+        for c in (args.config or ['{}'])
+    ]
+    peers = [peer for peer in args.peers.split(',') if peer]
     for peer in peers:
         make_tracker(peer)
     runs += [(peer, peer, None) for peer in peers]
     with Pool(args.jobs) as pool:
-        results = pool.map(run, [(name, runs, args.shift, START_SETS[args.starts]) for name in names], chunksize=1)
+        results = pool.map(
+            run, [(name, runs, args.shift, START_SETS[args.starts]) for name in names], chunksize=1
+        )
     groups = {n: load_sequence(n).group for n in names}
     n_starts = len(START_SETS[args.starts])
-    which = "the diagonals" if args.starts == "diagonal" else "the diagonals and the axes, and scaled by 0.8-1.2"
-    print(f"{len(names)} sequences x {n_starts} starts (ground truth, and shifted by {args.shift:g} of its size "
-          f"along {which})")
+    which = (
+        'the diagonals'
+        if args.starts == 'diagonal'
+        else 'the diagonals and the axes, and scaled by 0.8-1.2'
+    )
+    print(
+        f'{len(names)} sequences x {n_starts} starts (ground truth, and shifted by {args.shift:g} '
+        'of its size '
+        f'along {which})'
+    )
     for i, (label, _, _) in enumerate(runs):
         rows = [row for per_sequence in results for row in per_sequence[i]]
         overlap = np.array([ao for ao, _ in rows]).reshape(len(names), n_starts) * 100
         speed = np.median([ms for _, ms in rows])
-        starts = " ".join(f"{v:4.1f}" for v in overlap.mean(axis=0))
-        print(f"{label:60s} mean AO {overlap.mean():5.1f} %  per start {starts}  median update {speed:.1f} ms")
+        starts = ' '.join(f'{v:4.1f}' for v in overlap.mean(axis=0))
+        print(
+            f'{label:60s} mean AO {overlap.mean():5.1f} %  per start {starts}  median update '
+            f'{speed:.1f} ms'
+        )
         for group in sorted(set(groups.values())):
             rows_of = [k for k, n in enumerate(names) if groups[n] == group]
-            print(f"    {group}: mean AO {overlap[rows_of].mean():5.1f} % over {len(rows_of)} sequences x {n_starts}")
-        print("    " + " ".join(f"{n}={v:.1f}" for n, v in zip(names, overlap.mean(axis=1))))
+            print(
+                f'    {group}: mean AO {overlap[rows_of].mean():5.1f} % over {len(rows_of)} '
+                f'sequences x {n_starts}'
+            )
+        print('    ' + ' '.join(f'{n}={v:.1f}' for n, v in zip(names, overlap.mean(axis=1))))
 
 
-if __name__ == "__main__":
+if __name__ == '__main__':
     main()

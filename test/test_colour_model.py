@@ -1,13 +1,45 @@
-"""Staple's colour histograms: the per-pixel score beta, the window means, the start and the tracker's use."""
-import numpy as np
-import pytest
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
+"""
+Staple's colour histograms.
+
+The per-pixel score beta, the window means, the start and the tracker's use.
+"""
 from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
-from iemd_ros.tracking.colour_model import ColourModel
-from iemd_ros.evaluation.metrics import iou
 from iemd_ros.datasets.otb import load_sequence, read_frame
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.tracking.colour_model import ColourModel
+import numpy as np
+import pytest
 
 RED, GREEN, BLUE = (0, 0, 255), (0, 255, 0), (255, 0, 0)  # BGR
 
@@ -21,10 +53,15 @@ def _scene(shape=(120, 160), background=GREEN, target=RED, box=(60, 40, 21, 31))
 
 
 def test_beta_is_the_share_of_a_colour_on_the_target_and_windows_average_it():
-    """Target all red, surroundings all green: beta(red) = 1, beta(green) = 0, so a window's mean is the share of
-    it on red (hand-computed for the 21 x 31 px target: 1 on it, 16/21 5 px off, 1/2 half a width or height off,
-    between the positions 10 and 11 px off; 0 on bare background and outside the region); a colour neither has
-    scores 0.  (Odd sizes: the window's pixels then sit on image pixels, and nearest-neighbour sampling is exact.)"""
+    """
+    Target all red, surroundings all green.
+
+    beta(red) = 1, beta(green) = 0, so a window's mean is the share of it on red (hand-computed for
+    the 21 x 31 px target: 1 on it, 16/21 5 px off, 1/2 half a width or height off, between the
+    positions 10 and 11 px off; 0 on bare background and outside the region); a colour neither has
+    scores 0.  (Odd sizes: the window's pixels then sit on image pixels, and nearest-neighbour
+    sampling is exact.)
+    """
     box = (60, 40, 21, 31)
     model = ColourModel(model_area=10**6)  # no resampling: model pixels are image pixels
     frame = _scene(box=box)
@@ -43,14 +80,21 @@ def test_beta_is_the_share_of_a_colour_on_the_target_and_windows_average_it():
 
 
 def test_the_estimate_finds_the_moved_target_at_any_resampling_and_turn():
-    """The red target moved by (17, -9) px is found within a model pixel (half from nearest-neighbour sampling,
-    half from the window's size rounded to model pixels), with and
-    without resampling the region, and by a window turned by 90 degrees (its axes swap the target's width and
-    height)."""
+    """
+    The red target moved by (17, -9) px is found within a model pixel.
+
+    (half from nearest-neighbour sampling, half from the window's size rounded to model pixels),
+    with and without resampling the region, and by a window turned by 90 degrees (its axes swap the
+    target's width and height).
+    """
     box, move = (60, 40, 21, 31), np.array([17.0, -9.0])
     moved = (box[0] + 17, box[1] - 9, *box[2:])
     first, second = _scene(box=box), _scene(box=moved)
-    for model_area, angle, size in [(10**6, 0.0, box[2:]), (2048, 0.0, box[2:]), (10**6, np.pi / 2, box[:1:-1])]:
+    for model_area, angle, size in [
+        (10**6, 0.0, box[2:]),
+        (2048, 0.0, box[2:]),
+        (10**6, np.pi / 2, box[:1:-1]),
+    ]:
         model = ColourModel(model_area=model_area)
         model.init(first, box_centre(box), size, angle)
         estimate = model.estimate(second, box_centre(box), size, angle)
@@ -61,8 +105,12 @@ def test_the_estimate_finds_the_moved_target_at_any_resampling_and_turn():
 
 
 def test_update_blends_the_histograms_at_the_learning_rate():
-    """After the target turns blue, one update at rate 0.25 gives beta(blue) = 0.25 / (0.25 + 0) = 1 and leaves
-    beta(red) = 0.75 / 0.75 = 1 (neither colour is in the surroundings); the green surroundings stay at 0."""
+    """
+    After the target turns blue, one update at rate 0.25 gives beta(blue) = 0.25 /.
+
+    (0.25 + 0) = 1 and leaves beta(red) = 0.75 / 0.75 = 1 (neither colour is in the surroundings);
+    the green surroundings stay at 0.
+    """
     box = (60, 40, 21, 31)
     model = ColourModel(learning_rate=0.25, model_area=10**6)
     model.init(_scene(box=box), box_centre(box), box[2:])
@@ -74,29 +122,42 @@ def test_update_blends_the_histograms_at_the_learning_rate():
 
 
 def test_invalid_parameters_and_calls_raise():
-    for kwargs, message in [({"padding": -1.0}, "padding"), ({"learning_rate": 0.0}, "learning_rate"),
-                            ({"bins": 20}, "bins"), ({"bins": 128}, "bins")]:
+    for kwargs, message in [
+        ({'padding': -1.0}, 'padding'),
+        ({'learning_rate': 0.0}, 'learning_rate'),
+        ({'bins': 20}, 'bins'),
+        ({'bins': 128}, 'bins'),
+    ]:
         with pytest.raises(ValueError, match=message):
             ColourModel(**kwargs)
-    with pytest.raises(RuntimeError, match="before init"):
+    with pytest.raises(RuntimeError, match='before init'):
         ColourModel().estimate(_scene(), (70, 55), (20, 30))
-    with pytest.raises(RuntimeError, match="estimate"):
+    with pytest.raises(RuntimeError, match='estimate'):
         ColourModel().score_at((70, 55))
-    with pytest.raises(ValueError, match=r"colour_weight must be in \[0, 100\]"):
+    with pytest.raises(ValueError, match=r'colour_weight must be in \[0, 100\]'):
         TrackerConfig(colour_weight=-1.0)
 
 
 def test_the_tracker_uses_colour_on_colour_frames_only():
-    """A grey texture stored as BGR and a copy with the target tinted red, moved by 6 px: the colour model's peak
-    is one more start on the colour frames only; colour_weight 0 builds no model, and a grey frame in a colour
-    stream is tracked without it."""
+    """
+    A grey texture stored as BGR and a copy with the target tinted red, moved by 6 px.
+
+    The colour model's peak is one more start on the colour frames only; colour_weight 0 builds no
+    model, and a grey frame in a colour stream is tracked without it.
+    """
     grey = np.repeat(texture(seed=3)[..., None], 3, axis=2)
     colour = grey.copy()
     colour[40:80, 50:90, 2] = 255
     box = (50, 40, 40, 40)
-    for first, second, weight, starts in [(grey, grey, 1.0, 1), (colour, colour, 1.0, 2), (colour, colour, 0.0, 1),
-                                          (colour, colour[..., 2], 1.0, 1)]:
-        tracker = IemdTracker(TrackerConfig(colour_weight=weight, flow_start=False, translation_weight=0.0))
+    for first, second, weight, starts in [
+        (grey, grey, 1.0, 1),
+        (colour, colour, 1.0, 2),
+        (colour, colour, 0.0, 1),
+        (colour, colour[..., 2], 1.0, 1),
+    ]:
+        tracker = IemdTracker(
+            TrackerConfig(colour_weight=weight, flow_start=False, translation_weight=0.0)
+        )
         tracker.init(first, box)
         result = tracker.update(shifted(second, 6.0, 0.0))
         assert result.starts == starts, (weight, second.ndim)
@@ -105,10 +166,13 @@ def test_the_tracker_uses_colour_on_colour_frames_only():
 
 
 def test_tracks_a_real_colour_otb_excerpt(otb_root):
-    """Woman frames 1-100 (a colour sequence, so the colour model is on and its start is searched, a fourth
-    after the prediction, the flow and the translation filter): average overlap > 0.7 (0.78 measured; 0.76 with
-    colour_weight 0)."""
-    seq = load_sequence(otb_root / "Woman")
+    """
+    Woman frames 1-100: average overlap > 0.7 (0.78 measured; 0.76 with colour_weight 0).
+
+    A colour sequence, so the colour model is on and its start is searched, a fourth after the
+    prediction, the flow and the translation filter.
+    """
+    seq = load_sequence(otb_root / 'Woman')
     tracker = IemdTracker()
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     results = [tracker.update(read_frame(path)) for path in seq.frame_paths[1:100]]

@@ -1,20 +1,50 @@
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
 """EMD (section 3): optimal value, duals, and the two gradients with respect to y."""
+from iemd_ros.tracking.emd import appearance_distance, ground_distance, solve_emd, spatial_distance
 import numpy as np
 import pytest
 from scipy.optimize import linprog
 
-from iemd_ros.tracking.emd import appearance_distance, ground_distance, solve_emd, spatial_distance
-
 
 def linprog_emd(w_t, w_c, cost):
-    """Reference: the transportation problem of eqs. (4)-(8) with HiGHS."""
+    """Return reference: the transportation problem of eqs. (4)-(8) with HiGHS."""
     n_t, n_c = cost.shape
     a_eq = np.zeros((n_t + n_c, n_t * n_c))
     for u in range(n_t):
         a_eq[u, u * n_c:(u + 1) * n_c] = 1.0
     for v in range(n_c):
         a_eq[n_t + v, v::n_c] = 1.0
-    res = linprog(cost.ravel(), A_eq=a_eq, b_eq=np.concatenate([w_t, w_c]), bounds=(0, None), method="highs")
+    res = linprog(
+        cost.ravel(), A_eq=a_eq, b_eq=np.concatenate([w_t, w_c]), bounds=(0, None), method='highs'
+    )
     assert res.status == 0
     return res.fun
 
@@ -31,7 +61,7 @@ def random_problem(rng, n_t, n_c, dim=16):
     return w_t / w_t.sum(), w_c / w_c.sum(), ground_distance(eps_t, pos_t, eps_c, pos_c, 0.4)
 
 
-@pytest.mark.parametrize("n_t,n_c", [(9, 9), (49, 49), (49, 81), (30, 12)])
+@pytest.mark.parametrize('n_t,n_c', [(9, 9), (49, 49), (49, 81), (30, 12)])
 def test_emd_equals_linprog_optimum(n_t, n_c):
     rng = np.random.default_rng(n_t * 100 + n_c)
     w_t, w_c, cost = random_problem(rng, n_t, n_c)
@@ -74,18 +104,18 @@ def test_non_optimal_exit_is_reported_not_hidden():
     w_t, w_c, cost = random_problem(rng, 60, 60)
     sol = solve_emd(w_t, w_c, cost, max_iter=5)
     assert not sol.optimal
-    assert "iteration" in sol.message.lower() or sol.message != "optimal"
+    assert 'iteration' in sol.message.lower() or sol.message != 'optimal'
 
 
 def test_invalid_weights_are_rejected():
     cost = np.ones((2, 2))
-    with pytest.raises(ValueError, match="equal total"):
+    with pytest.raises(ValueError, match='equal total'):
         solve_emd(np.array([0.5, 0.5]), np.array([0.5, 0.6]), cost)
-    with pytest.raises(ValueError, match="non-negative"):
+    with pytest.raises(ValueError, match='non-negative'):
         solve_emd(np.array([1.5, -0.5]), np.array([0.5, 0.5]), cost)
-    with pytest.raises(ValueError, match="finite"):
+    with pytest.raises(ValueError, match='finite'):
         solve_emd(np.array([0.5, 0.5]), np.array([0.5, 0.5]), np.array([[0, np.nan], [1, 1]]))
-    with pytest.raises(ValueError, match="does not match"):
+    with pytest.raises(ValueError, match='does not match'):
         solve_emd(np.array([0.5, 0.5]), np.array([0.5, 0.5]), np.ones((3, 2)))
 
 
@@ -96,12 +126,18 @@ def test_ground_distance_terms_by_hand():
     pos_c = np.array([[0.5, 0.0], [0.0, -1.0]])
     assert np.allclose(appearance_distance(eps_t, eps_c), [[2.0, 0.0]])
     assert np.allclose(spatial_distance(pos_t, pos_c), [[0.25, 1.0]])
-    assert np.allclose(ground_distance(eps_t, pos_t, eps_c, pos_c, 0.3), [[0.3 * 2 + 0.7 * 0.25, 0.7 * 1.0]])
+    assert np.allclose(
+        ground_distance(eps_t, pos_t, eps_c, pos_c, 0.3), [[0.3 * 2 + 0.7 * 0.25, 0.7 * 1.0]]
+    )
 
 
 def test_duals_of_zero_weight_bins_stay_dual_feasible():
-    """The network simplex leaves the duals of empty bins arbitrary; solve_emd gives them the tightest
-    feasible values, so every reduced cost d_uv - u_u - v_v stays >= 0 (eq. 8's dual)."""
+    """
+    The network simplex leaves the duals of empty bins arbitrary.
+
+    solve_emd gives them the tightest feasible values, so every reduced cost d_uv - u_u - v_v stays
+    >= 0 (eq. 8's dual).
+    """
     rng = np.random.default_rng(7)
     w_t, w_c, cost = random_problem(rng, 12, 15)
     w_t[[2, 7]], w_c[[0, 5, 9]] = 0.0, 0.0
@@ -110,5 +146,6 @@ def test_duals_of_zero_weight_bins_stay_dual_feasible():
     assert sol.optimal
     reduced = cost - sol.u[:, None] - sol.v[None, :]
     assert reduced.min() > -1e-10
-    assert np.isclose(reduced[[2, 7]].min(axis=1), 0.0, atol=1e-12).all()   # tightest: one reduced cost is 0
+    # tightest: one reduced cost is 0
+    assert np.isclose(reduced[[2, 7]].min(axis=1), 0.0, atol=1e-12).all()
     assert np.isclose(reduced[:, [0, 5, 9]].min(axis=0), 0.0, atol=1e-12).all()

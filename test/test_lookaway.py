@@ -1,55 +1,93 @@
-"""Look-away-and-back sequences and the long-term measures (VOT LT precision, recall, F; false reports; returns)."""
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
+"""
+Look-away-and-back sequences and the long-term measures.
+
+(VOT LT precision, recall, F; false reports; returns).
+"""
 import json
 from pathlib import Path
 
 import cv2
-import numpy as np
-import pytest
-
 from iemd_ros.apps.eval import main as eval_main
 from iemd_ros.apps.make_lookaway import main as make_main
-from iemd_ros.datasets.lookaway import LookAway, look_away_windows, write_look_away
-from iemd_ros.datasets.otb import Sequence, load_sequence
-from iemd_ros.evaluation.metrics import REACQUIRE_WITHIN, long_term_scores
+from iemd_ros.datasets.lookaway import look_away_windows, LookAway, write_look_away
+from iemd_ros.datasets.otb import load_sequence, Sequence
+from iemd_ros.evaluation.metrics import long_term_scores, REACQUIRE_WITHIN
 from iemd_ros.tracking import IemdTracker
+import numpy as np
+import pytest
 
 NAN = [np.nan] * 4
 
 
 def test_long_term_scores_by_hand():
-    """10 frames, the target absent on frames 4-6: reports with IoU 1 on 0-3, a false report on 4, none on 5-7,
-    IoU 0.5 from frame 8 (re-acquired one frame after the return at 7)."""
+    """
+    10 frames, the target absent on frames 4-6.
+
+    Reports with IoU 1 on 0-3, a false report on 4, none on 5-7, IoU 0.5 from frame 8 (re-acquired
+    one frame after the return at 7).
+    """
     gt = np.array([[10, 10, 10, 10]] * 4 + [NAN] * 3 + [[10, 10, 10, 10]] * 3, float)
     half = [15, 10, 10, 10]  # overlaps the target by 5x10 of 150: IoU 1/3
-    pred = np.array([[10, 10, 10, 10]] * 4 + [[50, 50, 5, 5]] + [NAN] * 3 + [[10, 10, 10, 10], half], float)
+    pred = np.array(
+        [[10, 10, 10, 10]] * 4 + [[50, 50, 5, 5]] + [NAN] * 3 + [[10, 10, 10, 10], half], float
+    )
     reported = np.array([True] * 5 + [False] * 3 + [True] * 2)
     s = long_term_scores(pred, reported, gt)
     precision = (4 * 1.0 + 0 + 1.0 + 1 / 3) / 7  # 7 reports, the false one scores 0
-    recall = (4 * 1.0 + 0 + 1.0 + 1 / 3) / 7      # 7 present frames, frame 7 unreported
+    recall = (4 * 1.0 + 0 + 1.0 + 1 / 3) / 7  # 7 present frames, frame 7 unreported
     assert s.precision == pytest.approx(precision) and s.recall == pytest.approx(recall)
     assert s.f_score == pytest.approx(2 * precision * recall / (precision + recall))
     assert (s.absent_frames, s.returns, s.reacquired, s.delays) == (3, 1, 1, [1])
     assert s.false_report_rate == pytest.approx(1 / 3)
     never = long_term_scores(pred, reported & (np.arange(10) < 7), gt)
     assert never.delays == [-1] and never.reacquired == 0 and never.recall < s.recall
-    with pytest.raises(ValueError, match="lengths differ"):
+    with pytest.raises(ValueError, match='lengths differ'):
         long_term_scores(pred[:5], reported, gt)
 
 
 def _moving_target_sequence(tmp_path: Path, n: int = 90) -> Sequence:
-    """A 16x12 bright square moving 2 px per frame to the right over a 320x240 textured scene."""
+    """Return a 16x12 bright square moving 2 px per frame to the right over a 320x240 scene."""
     rng = np.random.default_rng(0)
     scene = cv2.GaussianBlur(rng.integers(0, 255, (240, 320, 3), dtype=np.uint8), (0, 0), 3)
-    folder = tmp_path / "src" / "Mover"
-    (folder / "img").mkdir(parents=True)
+    folder = tmp_path / 'src' / 'Mover'
+    (folder / 'img').mkdir(parents=True)
     boxes = []
     for k in range(n):
         x, y = 60 + 2 * k, 150
         img = scene.copy()
-        img[y:y + 12, x:x + 16] = (250, 250, 250)
-        cv2.imwrite(str(folder / "img" / f"{k + 1:04d}.jpg"), img)
+        img[y: y + 12, x: x + 16] = (250, 250, 250)
+        cv2.imwrite(str(folder / 'img' / f'{k + 1:04d}.jpg'), img)
         boxes.append((x + 1, y + 1, 16, 12))
-    (folder / "groundtruth_rect.txt").write_text("\n".join(",".join(map(str, b)) for b in boxes))
+    (folder / 'groundtruth_rect.txt').write_text('\n'.join(','.join(map(str, b)) for b in boxes))
     return load_sequence(folder)
 
 
@@ -58,48 +96,75 @@ def test_the_window_looks_away_for_the_set_frames_and_comes_back(tmp_path):
     cfg = LookAway(crop=0.5, follow_frames=10, away_frames=20, pan_px=30.0)
     origins, (w, h) = look_away_windows(seq, (320, 240), cfg)
     assert (w, h) == (160, 120)
-    assert (origins[:, 0] >= 0).all() and (origins[:, 0] <= 160).all() and (origins[:, 1] <= 120).all()
-    out = load_sequence(write_look_away(seq, tmp_path / "out", cfg))
+    assert (
+        (origins[:, 0] >= 0).all()
+        and (origins[:, 0] <= 160).all()
+        and (origins[:, 1] <= 120).all()
+    )
+    out = load_sequence(write_look_away(seq, tmp_path / 'out', cfg))
     absent = np.flatnonzero(np.isnan(out.gt_boxes[:, 0]))
     assert len(out) == len(seq) and len(absent) >= cfg.away_frames
-    assert absent[0] >= cfg.follow_frames and np.all(np.diff(absent) == 1)  # one absence, after the follow
+    # one absence, after the follow
+    assert absent[0] >= cfg.follow_frames and np.all(np.diff(absent) == 1)
     assert not np.isnan(out.gt_boxes[-1]).any()
     # the annotation is the target in the window's pixels: the bright square is where the GT says
     k = absent[0] - 1
     x, y, bw, bh = out.gt_boxes[k]
     frame = cv2.imread(str(out.frame_paths[k]))
     assert frame.shape[:2] == (120, 160)
-    assert frame[int(y) + 2:int(y + bh) - 2, int(x) + 2:int(x + bw) - 2].mean() > 200
+    assert frame[int(y) + 2: int(y + bh) - 2, int(x) + 2: int(x + bw) - 2].mean() > 200
 
 
 def test_a_target_too_large_to_leave_the_window_is_refused(tmp_path):
     seq = _moving_target_sequence(tmp_path, 60)
-    with pytest.raises(ValueError, match="cannot stay out of"):
+    with pytest.raises(ValueError, match='cannot stay out of'):
         look_away_windows(seq, (320, 240), LookAway(crop=0.9))
-    with pytest.raises(ValueError, match="too few"):
+    with pytest.raises(ValueError, match='too few'):
         look_away_windows(seq, (320, 240), LookAway(follow_frames=40, away_frames=30))
 
 
 def test_eval_reports_the_long_term_measures_of_a_look_away_sequence(tmp_path, capsys):
     seq = _moving_target_sequence(tmp_path)
-    assert make_main([str(seq.frame_paths[0].parents[1]), "--out", str(tmp_path / "la"), "--follow", "10",
-                      "--away", "20", "--pan-px", "30"]) == 0
-    out = tmp_path / "eval"
-    assert eval_main([str(tmp_path / "la" / "src"), "--trackers", "kcf", "--out", str(out)]) == 0
+    assert (
+        make_main(
+            [
+                str(seq.frame_paths[0].parents[1]),
+                '--out',
+                str(tmp_path / 'la'),
+                '--follow',
+                '10',
+                '--away',
+                '20',
+                '--pan-px',
+                '30',
+            ]
+        )
+        == 0
+    )
+    out = tmp_path / 'eval'
+    assert eval_main([str(tmp_path / 'la' / 'src'), '--trackers', 'kcf', '--out', str(out)]) == 0
     text = capsys.readouterr().out
-    assert "long-term measures (the target leaves the view)" in text
-    doc = json.loads((out / "results.json").read_text())
-    lt = doc["results"]["kcf"]["Mover"]["long_term"]
-    assert lt["absent_frames"] >= 20 and lt["returns"] == 1 and 0 <= lt["f_score"] <= 1
-    assert doc["long_term"]["kcf"]["n_sequences"] == 1 and REACQUIRE_WITHIN == 30
+    assert 'long-term measures (the target leaves the view)' in text
+    doc = json.loads((out / 'results.json').read_text())
+    lt = doc['results']['kcf']['Mover']['long_term']
+    assert lt['absent_frames'] >= 20 and lt['returns'] == 1 and 0 <= lt['f_score'] <= 1
+    assert doc['long_term']['kcf']['n_sequences'] == 1 and REACQUIRE_WITHIN == 30
 
 
-def test_the_tracker_says_lost_while_a_real_target_is_away_and_finds_it_on_return(tmp_path, uav_root):
-    """building5 (a drone's view of a walking person) cut into a look-away sequence: the window pans off her for
-    about 30 frames and back.  The tracker reports no box on at least 90 % of the absent frames, is back on her
-    within REACQUIRE_WITHIN frames of her return, and its long-term F-score is at least 0.6 (measured: no report on
-    an absent frame, back at once, F 0.81)."""
-    seq = load_sequence(write_look_away(load_sequence(uav_root / "building5"), tmp_path / "la", LookAway()))
+def test_the_tracker_says_lost_while_a_real_target_is_away_and_finds_it_on_return(
+    tmp_path, uav_root
+):
+    """
+    building5 (a drone's view of a walking person) cut into a look-away sequence.
+
+    The window pans off her for about 30 frames and back.  The tracker reports no box on at least
+    90 % of the absent frames, is back on her within REACQUIRE_WITHIN frames of her return, and its
+    long-term F-score is at least 0.6 (measured: no report on an absent frame, back at once, F
+    0.81).
+    """
+    seq = load_sequence(
+        write_look_away(load_sequence(uav_root / 'building5'), tmp_path / 'la', LookAway())
+    )
     frames = [cv2.imread(str(path)) for path in seq.frame_paths]
     tracker = IemdTracker()
     tracker.init(frames[0], seq.gt_boxes[0])

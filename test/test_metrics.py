@@ -1,25 +1,53 @@
-"""Hand-computed checks of the OTB metrics (iemd_ros.evaluation.metrics)."""
-import numpy as np
-import pytest
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
+"""Hand-computed checks of the OTB metrics (iemd_ros.evaluation.metrics)."""
 from iemd_ros.evaluation.metrics import (
-    OTB_THRESHOLDS,
     average_overlap,
     center_error,
     fraction_above,
     iou,
+    OTB_THRESHOLDS,
     precision_at,
     score_sequence,
     success_auc,
     success_curve,
     valid_boxes,
 )
+import numpy as np
+import pytest
 
 A = (0.0, 0.0, 10.0, 10.0)
 
 
 @pytest.mark.parametrize(
-    "b, expected",
+    'b, expected',
     [
         ((0, 0, 10, 10), 1.0),                 # identical
         ((5, 5, 10, 10), 25 / 175),            # partial: 5x5 inside, union 100 + 100 - 25
@@ -40,7 +68,8 @@ def test_iou_hand_cases(b, expected):
 
 
 def test_iou_matches_otb_pixel_inclusive_case():
-    # OTB calcRectInt on 1-based pixels (1,1,3,3) and (2,2,3,3): columns 2..3 and rows 2..3 overlap -> 4 px.
+    # OTB calcRectInt on 1-based pixels (1,1,3,3) and (2,2,3,3): columns 2..3 and rows 2..3 overlap
+    # -> 4 px.
     assert iou((1, 1, 3, 3), (2, 2, 3, 3))[0] == pytest.approx(4 / 14)
 
 
@@ -53,75 +82,83 @@ def test_iou_vectorized_and_broadcast():
 
 
 def test_iou_rejects_bad_shapes():
-    with pytest.raises(ValueError, match="shape"):
+    with pytest.raises(ValueError, match='shape'):
         iou([1, 2, 3], A)
-    with pytest.raises(ValueError, match="different lengths"):
+    with pytest.raises(ValueError, match='different lengths'):
         iou(np.zeros((3, 4)), np.ones((2, 4)))
 
 
 def test_valid_boxes():
     np.testing.assert_array_equal(
-        valid_boxes([[0, 0, 1, 1], [0, 0, 0, 1], [np.nan, 0, 1, 1], [0, 0, 1, np.inf]]), [True, False, False, False]
+        valid_boxes([[0, 0, 1, 1], [0, 0, 0, 1], [np.nan, 0, 1, 1], [0, 0, 1, np.inf]]),
+        [True, False, False, False],
     )
 
 
 def test_center_error():
-    np.testing.assert_allclose(center_error(A, [[3, 4, 10, 10], [0, 0, 10, 10], [0, 0, 20, 20]]), [5.0, 0.0, np.hypot(5, 5)])
+    np.testing.assert_allclose(
+        center_error(A, [[3, 4, 10, 10], [0, 0, 10, 10], [0, 0, 20, 20]]),
+        [5.0, 0.0, np.hypot(5, 5)],
+    )
     assert center_error(A, (np.nan, 0, 1, 1))[0] == np.inf
     assert center_error((0, 0, 0, 0), A)[0] == np.inf  # OpenCV's failure box
 
 
 def test_success_curve_is_strict():
     ious = np.array([0.0, 0.3, 0.5, 1.0])
-    np.testing.assert_allclose(success_curve(ious, [0.0, 0.3, 0.5, 0.99, 1.0]), [0.75, 0.5, 0.25, 0.25, 0.0])
+    np.testing.assert_allclose(
+        success_curve(ious, [0.0, 0.3, 0.5, 0.99, 1.0]), [0.75, 0.5, 0.25, 0.25, 0.0]
+    )
 
 
 def test_success_auc_on_hand_arrays():
     assert len(OTB_THRESHOLDS) == 21
-    assert success_auc(np.ones(5)) == pytest.approx(20 / 21)   # overlap 1 passes every t < 1
+    assert success_auc(np.ones(5)) == pytest.approx(20 / 21)  # overlap 1 passes every t < 1
     assert success_auc(np.zeros(5)) == 0.0
-    assert success_auc([0.52]) == pytest.approx(11 / 21)       # t = 0, 0.05, ..., 0.5
+    assert success_auc([0.52]) == pytest.approx(11 / 21)  # t = 0, 0.05, ..., 0.5
     assert success_auc([0.52, 0.0]) == pytest.approx(11 / 42)
 
 
 def test_auc_tends_to_average_overlap():
     ious = np.random.default_rng(0).uniform(0, 1, 200)
-    assert success_auc(ious, np.linspace(0, 1, 20001)) == pytest.approx(average_overlap(ious), abs=1e-3)
+    assert success_auc(ious, np.linspace(0, 1, 20001)) == pytest.approx(
+        average_overlap(ious), abs=1e-3
+    )
     assert abs(success_auc(ious) - average_overlap(ious)) < 0.05  # 21 thresholds: close, not equal
 
 
 def test_precision_and_fractions():
-    assert precision_at([0.0, 20.0, 20.1, np.inf]) == 0.5      # <= 20 px
+    assert precision_at([0.0, 20.0, 20.1, np.inf]) == 0.5  # <= 20 px
     assert precision_at([0.0, 5.0, 9.0], 5) == pytest.approx(2 / 3)
     ious = [0.0, 0.3, 0.5]
     assert average_overlap(ious) == pytest.approx(0.8 / 3)
     assert fraction_above(ious, 0) == pytest.approx(2 / 3)
     assert fraction_above(ious, 0.4) == pytest.approx(1 / 3)
-    assert fraction_above([0.4], 0.4) == 0.0                    # strictly greater
+    assert fraction_above([0.4], 0.4) == 0.0  # strictly greater
 
 
 def test_empty_or_nan_inputs_raise():
-    with pytest.raises(ValueError, match="empty"):
+    with pytest.raises(ValueError, match='empty'):
         average_overlap([])
-    with pytest.raises(ValueError, match="NaN"):
+    with pytest.raises(ValueError, match='NaN'):
         success_auc([0.5, np.nan])
 
 
 def test_score_sequence_excludes_absent_gt_frames():
     gt = np.array([[0, 0, 10, 10], [5, 5, 10, 10], [np.nan] * 4, [0, 0, 10, 10]])
     pred = np.array([[0, 0, 10, 10], [0, 0, 10, 10], [0, 0, 10, 10], [0, 0, 0, 0]])
-    s = score_sequence(pred, gt, "toy", fps=12.5)
+    s = score_sequence(pred, gt, 'toy', fps=12.5)
     assert (s.n_frames, s.n_absent) == (3, 1)
     assert s.average_overlap == pytest.approx((1 + 1 / 7 + 0) / 3)
-    assert s.precision_20 == pytest.approx(2 / 3)                # centre errors 0, 7.07, inf
+    assert s.precision_20 == pytest.approx(2 / 3)  # centre errors 0, 7.07, inf
     assert s.overlap_gt_0 == pytest.approx(2 / 3)
     assert s.overlap_gt_04 == pytest.approx(1 / 3)
     assert s.success_auc == pytest.approx(np.mean(s.success_curve))
-    assert s.fps == 12.5 and s.to_dict()["name"] == "toy"
+    assert s.fps == 12.5 and s.to_dict()['name'] == 'toy'
 
 
 def test_score_sequence_errors():
-    with pytest.raises(ValueError, match="2 predicted boxes for 3"):
-        score_sequence(np.zeros((2, 4)), np.ones((3, 4)), "x")
-    with pytest.raises(ValueError, match="no frame has a valid"):
-        score_sequence(np.zeros((2, 4)), np.full((2, 4), np.nan), "x")
+    with pytest.raises(ValueError, match='2 predicted boxes for 3'):
+        score_sequence(np.zeros((2, 4)), np.ones((3, 4)), 'x')
+    with pytest.raises(ValueError, match='no frame has a valid'):
+        score_sequence(np.zeros((2, 4)), np.full((2, 4), np.nan), 'x')

@@ -1,9 +1,37 @@
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
 """Sparse codes (eq. lagrange), max-alignment pooling and the kernel weights (section 4)."""
+from iemd_ros.tracking.histogram import candidate_weights, target_weights
+from iemd_ros.tracking.sparse_coding import lasso_objective, max_alignment_pooling, SparseCoder
 import numpy as np
 import pytest
-
-from iemd_ros.tracking.histogram import candidate_weights, target_weights
-from iemd_ros.tracking.sparse_coding import SparseCoder, lasso_objective, max_alignment_pooling
 
 
 def patch_dictionary(seed=0, dim=64, n_atoms=147, n_signals=40):
@@ -19,13 +47,16 @@ def patch_dictionary(seed=0, dim=64, n_atoms=147, n_signals=40):
 
 
 def kkt_residual(atoms, signals, codes, lam):
-    """Optimality of min ||e - Phi a||^2 + lam |a|_1, a >= 0: gradient g = 2 Phi'(Phi a - e) + lam
-    must vanish where a > 0 and be >= 0 where a = 0."""
+    """
+    Optimality of min ||e - Phi a||^2 + lam |a|_1, a >= 0.
+
+    Gradient g = 2 Phi'(Phi a - e) + lam must vanish where a > 0 and be >= 0 where a = 0.
+    """
     g = 2 * atoms.T @ (atoms @ codes - signals) + lam
     return np.where(codes > 0, np.abs(g), np.maximum(-g, 0)).max()
 
 
-@pytest.mark.parametrize("lam", [0.01, 0.1, 0.5])
+@pytest.mark.parametrize('lam', [0.01, 0.1, 0.5])
 def test_codes_satisfy_kkt_conditions(lam):
     atoms, signals = patch_dictionary()
     codes = SparseCoder(atoms, lam).encode(signals)
@@ -78,9 +109,9 @@ def test_target_weights_by_hand():
     # h = 2: profile (1, 1 - 0.0625, 0.75, 0.5); |p| of the negative code
     expected = np.array([2.0, 0.9375, 3.75, 0.5])
     assert np.allclose(target_weights(codes, pos, 2.0), expected / expected.sum())
-    with pytest.raises(ValueError, match="empty"):
+    with pytest.raises(ValueError, match='empty'):
         target_weights(np.zeros(4), pos, 1.0)
-    with pytest.raises(ValueError, match="empty"):
+    with pytest.raises(ValueError, match='empty'):
         target_weights(np.array([0.0, 0.0, 1.0, 1.0]), pos, 1.0)  # codes only outside the kernel
 
 
@@ -94,5 +125,8 @@ def test_candidate_weights_jacobian_matches_finite_differences():
     assert np.allclose(dw.sum(0), 0.0, atol=1e-12)  # normalization is differentiated too
     h = 1e-7
     for k, e in enumerate(np.eye(2)):
-        fd = (candidate_weights(q, pos, y + h * e, 1.02)[0] - candidate_weights(q, pos, y - h * e, 1.02)[0]) / (2 * h)
+        fd = (
+            candidate_weights(q, pos, y + h * e, 1.02)[0]
+            - candidate_weights(q, pos, y - h * e, 1.02)[0]
+        ) / (2 * h)
         assert np.allclose(dw[:, k], fd, atol=1e-6)

@@ -1,26 +1,70 @@
-"""Command-line plumbing shared by every ``iemd-*`` command: bad input gives one line and exit 2."""
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
+"""
+Command-line plumbing shared by every ``iemd-*`` command.
+
+Bad input gives one line and exit 2.
+"""
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Callable
+import sys
 
-__all__ = ["CliParser", "UsageError", "cli_main", "one_line", "split_ros_args"]
+__all__ = ['CliParser', 'UsageError', 'cli_main', 'one_line', 'split_ros_args']
 
 
 class UsageError(Exception):
-    """A command-line usage error (:meth:`CliParser.error`), which :func:`cli_main` reports in one line."""
+    """
+    A command-line usage error (:meth:`CliParser.error`).
+
+    Which :func:`cli_main` reports in one line.
+    """
+
     pass
 
 
 class CliParser(argparse.ArgumentParser):
-    """``argparse.ArgumentParser`` whose errors raise :class:`UsageError` instead of printing the usage and exiting.
+    """
+    ``argparse.ArgumentParser`` whose errors raise :class:`UsageError`.
+
+    It does not print the usage and exit.
 
     It takes the parameters of :class:`argparse.ArgumentParser`.
     """
 
     def error(self, message: str):  # one readable line, exit 2 (no usage dump)
-        """Report a usage error as one readable line, exit 2 (no usage dump), through :func:`cli_main`.
+        """
+        Report a usage error as one readable line, exit 2 (no usage dump).
+
+        Through :func:`cli_main`.
 
         Parameters
         ----------
@@ -31,12 +75,14 @@ class CliParser(argparse.ArgumentParser):
         ------
         UsageError
             Always, with ``message``.
+
         """
         raise UsageError(message)
 
 
 def one_line(exc: BaseException) -> str:
-    """An exception's message on one line of at most 300 characters.
+    """
+    Return an exception's message on one line of at most 300 characters.
 
     Parameters
     ----------
@@ -46,14 +92,19 @@ def one_line(exc: BaseException) -> str:
     Returns
     -------
     str
-        Its message with the whitespace collapsed (its type's name when empty), cut with "..." at 300 characters.
+        Its message with the whitespace collapsed (its type's name when empty), cut with "..." at
+        300 characters.
+
     """
-    text = " ".join(str(exc).split()) or type(exc).__name__
-    return text if len(text) < 300 else text[:297] + "..."
+    text = ' '.join(str(exc).split()) or type(exc).__name__
+    return text if len(text) < 300 else text[:297] + '...'
 
 
 def split_ros_args(argv: list[str] | None) -> tuple[list[str], list[str]]:
-    """Split ``argv`` into the command's own arguments and the ``--ros-args ...`` tail, as ``ros2 run`` passes them.
+    """
+    Split ``argv`` into the command's own arguments and the ``--ros-args ...`` tail.
+
+    As ``ros2 run`` passes them.
 
     Parameters
     ----------
@@ -66,14 +117,18 @@ def split_ros_args(argv: list[str] | None) -> tuple[list[str], list[str]]:
         The arguments before ``--ros-args``.
     ros : list of str
         ``--ros-args`` and the arguments after it (empty without it).
+
     """
     args = list(sys.argv[1:] if argv is None else argv)
-    cut = args.index("--ros-args") if "--ros-args" in args else len(args)
+    cut = args.index('--ros-args') if '--ros-args' in args else len(args)
     return args[:cut], args[cut:]
 
 
 def cli_main(prog: str, body: Callable[[], int]) -> int:
-    """Run ``body``; bad arguments / files (ValueError, OSError, usage errors) -> one stderr line, exit 2.
+    """
+    Run ``body``; bad arguments / files (ValueError, OSError, usage errors) -> one stderr line.
+
+    Exit 2.
 
     Parameters
     ----------
@@ -86,12 +141,13 @@ def cli_main(prog: str, body: Callable[[], int]) -> int:
     -------
     int
         ``body``'s exit status, 2 for bad input, 130 when interrupted.
+
     """
     try:
         return body()
     except (UsageError, ValueError, OSError) as exc:
-        print(f"{prog}: error: {one_line(exc)}", file=sys.stderr)
+        print(f'{prog}: error: {one_line(exc)}', file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"{prog}: interrupted", file=sys.stderr)
+        print(f'{prog}: interrupted', file=sys.stderr)
         return 130

@@ -1,10 +1,40 @@
-"""Loading of OTB-layout sequences (Wu, Lim & Yang 2013), the benchmark of the paper's evaluation.
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
-Layout: ``<root>/<Seq>/img/<frame number>.jpg`` (``0001.jpg``, ``000001.jpg``, ``img000001.jpg``: the number ends the
-name) and ``<root>/<Seq>/groundtruth_rect.txt``.  GT lines are
-``x, y, w, h`` with 1-based pixel coordinates, separated by commas, tabs or spaces (CRLF and a missing
-final newline occur); blank lines are ignored; a line of ``NaN`` values marks a frame where the target is absent.
-Boxes are returned 0-based (``x - 1, y - 1``).
+"""
+Loading of OTB-layout sequences (Wu, Lim & Yang 2013), the benchmark of the paper's evaluation.
+
+Layout: ``<root>/<Seq>/img/<frame number>.jpg`` (``0001.jpg``, ``000001.jpg``, ``img000001.jpg``:
+the number ends the name) and ``<root>/<Seq>/groundtruth_rect.txt``.  GT lines are ``x, y, w, h``
+with 1-based pixel coordinates, separated by commas, tabs or spaces (CRLF and a missing final
+newline occur); blank lines are ignored; a line of ``NaN`` values marks a frame where the target is
+absent.  Boxes are returned 0-based (``x - 1, y - 1``).
 
 * Line *i* of the GT belongs to the *i*-th image in frame-number order; frame numbers come from the
   file names (David starts at 0300, as in the OTB toolkit's ``configSeqs``).
@@ -14,25 +44,26 @@ Boxes are returned 0-based (``x - 1, y - 1``).
 """
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 from pathlib import Path
+import re
 from typing import Iterator
 
 import cv2
 import numpy as np
 
-GT_NAME = "groundtruth_rect.txt"
-_MULTI_GT = re.compile(r"^groundtruth_rect\.(\d+)\.txt$")
-_TARGET_NAME = re.compile(r"^(.+)-(\d+)$")
-_SPLIT = re.compile(r"[,\s]+")
-_FRAME_NUMBER = re.compile(r"(\d+)$")  # the digits that end an image's name
-IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png")
+GT_NAME = 'groundtruth_rect.txt'
+_MULTI_GT = re.compile(r'^groundtruth_rect\.(\d+)\.txt$')
+_TARGET_NAME = re.compile(r'^(.+)-(\d+)$')
+_SPLIT = re.compile(r'[,\s]+')
+_FRAME_NUMBER = re.compile(r'(\d+)$')  # the digits that end an image's name
+IMAGE_SUFFIXES = ('.jpg', '.jpeg', '.png')
 
 
 @dataclass(frozen=True)
 class Sequence:
-    """One OTB target: its frames (in order) and 0-based ``(x, y, w, h)`` GT boxes.
+    """
+    One OTB target: its frames (in order) and 0-based ``(x, y, w, h)`` GT boxes.
 
     Parameters
     ----------
@@ -46,19 +77,21 @@ class Sequence:
         Frame numbers, from the file names.
     group : str, optional
         The folder of sequences it comes from (``otb``, ``uav``): means are taken per group.
+
     """
 
     name: str
     frame_paths: tuple[Path, ...]
     gt_boxes: np.ndarray
     frame_numbers: tuple[int, ...] = ()
-    group: str = ""
+    group: str = ''
 
     def __len__(self) -> int:
         return len(self.frame_paths)
 
-    def head(self, n: int) -> "Sequence":
-        """The first ``n`` frames (all of them when ``n`` >= len).
+    def head(self, n: int) -> 'Sequence':
+        """
+        Return the first ``n`` frames (all of them when ``n`` >= len).
 
         Parameters
         ----------
@@ -74,13 +107,17 @@ class Sequence:
         ------
         ValueError
             For ``n`` < 1.
+
         """
         if n < 1:
-            raise ValueError(f"{self.name}: number of frames must be >= 1, got {n}")
-        return Sequence(self.name, self.frame_paths[:n], self.gt_boxes[:n], self.frame_numbers[:n], self.group)
+            raise ValueError(f'{self.name}: number of frames must be >= 1, got {n}')
+        return Sequence(
+            self.name, self.frame_paths[:n], self.gt_boxes[:n], self.frame_numbers[:n], self.group
+        )
 
     def frames(self) -> Iterator[np.ndarray]:
-        """The frames as BGR uint8 arrays (grayscale JPEGs come back 3-channel).
+        """
+        Yield the frames as BGR uint8 arrays (grayscale JPEGs come back 3-channel).
 
         Yields
         ------
@@ -91,13 +128,15 @@ class Sequence:
         ------
         ValueError
             For an image that cannot be decoded.
+
         """
         for path in self.frame_paths:
             yield read_frame(path)
 
 
 def read_frame(path: str | Path) -> np.ndarray:
-    """Read one image with OpenCV.
+    """
+    Read one image with OpenCV.
 
     Parameters
     ----------
@@ -113,25 +152,28 @@ def read_frame(path: str | Path) -> np.ndarray:
     ------
     ValueError
         If it cannot be decoded.
+
     """
     img = cv2.imread(str(path))
     if img is None:
-        raise ValueError(f"cannot read image {path}")
+        raise ValueError(f'cannot read image {path}')
     return img
 
 
 def parse_groundtruth(path: str | Path, with_flags: bool = False):
-    r"""Parse a GT file into 0-based ``(x, y, w, h)`` boxes.
+    r"""
+    Parse a GT file into 0-based ``(x, y, w, h)`` boxes.
 
-    Each non-empty line is split on ``[,\s]+`` and must hold exactly four numbers; a box with a non-finite value
-    ("NaN") marks an absent target and becomes all NaN.
+    Each non-empty line is split on ``[,\s]+`` and must hold exactly four numbers; a box with a
+    non-finite value ("NaN") marks an absent target and becomes all NaN.
 
     Parameters
     ----------
     path : str or Path
         The GT file, 1-based boxes.
     with_flags : bool, optional
-        A line may carry a 5th flag column (default "ok"; "absent" also gives a NaN box), and the flags are returned.
+        A line may carry a 5th flag column (default "ok"; "absent" also gives a NaN box), and the
+        flags are returned.
 
     Returns
     -------
@@ -143,49 +185,51 @@ def parse_groundtruth(path: str | Path, with_flags: bool = False):
     Raises
     ------
     ValueError
-        For a file that cannot be read, has no box, or a line that is not four numbers (and the optional flag).
+        For a file that cannot be read, has no box, or a line that is not four numbers (and the
+        optional flag).
+
     """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8", errors="strict")
+        text = path.read_text(encoding='utf-8', errors='strict')
     except (OSError, UnicodeDecodeError) as exc:
-        raise ValueError(f"cannot read ground truth {path}: {exc}") from None
+        raise ValueError(f'cannot read ground truth {path}: {exc}') from None
     rows, flags = [], []
     for lineno, line in enumerate(text.splitlines(), start=1):
         line = line.strip()
         if not line:
             continue
         fields = _SPLIT.split(line)
-        flag = fields.pop() if with_flags and len(fields) == 5 else "ok"
+        flag = fields.pop() if with_flags and len(fields) == 5 else 'ok'
         try:
             values = [float(f) for f in fields]
         except ValueError:
-            raise ValueError(f"{path}:{lineno}: not a number: bad box line {line!r}") from None
+            raise ValueError(f'{path}:{lineno}: not a number: bad box line {line!r}') from None
         if len(values) != 4:
-            want = "4 values x,y,w,h" + (" and an optional flag" if with_flags else "")
-            raise ValueError(f"{path}:{lineno}: expected {want}, got {len(fields)} in {line!r}")
-        if flag == "absent" or not np.all(np.isfinite(values)):
+            want = '4 values x,y,w,h' + (' and an optional flag' if with_flags else '')
+            raise ValueError(f'{path}:{lineno}: expected {want}, got {len(fields)} in {line!r}')
+        if flag == 'absent' or not np.all(np.isfinite(values)):
             values = [np.nan] * 4
         rows.append(values)
         flags.append(flag)
     if not rows:
-        raise ValueError(f"{path}: ground-truth file has no boxes")
+        raise ValueError(f'{path}: ground-truth file has no boxes')
     boxes = np.asarray(rows, dtype=float)
     boxes[:, :2] -= 1.0  # 1-based -> 0-based
     return (boxes, np.array(flags)) if with_flags else boxes
 
 
 def _frames_of(folder: Path) -> tuple[list[Path], list[int]]:
-    img_dir = folder / "img"
+    img_dir = folder / 'img'
     if not img_dir.is_dir():
-        raise ValueError(f"{folder} is not an OTB sequence: no img/ folder")
+        raise ValueError(f'{folder} is not an OTB sequence: no img/ folder')
     paths = [p for p in img_dir.iterdir() if p.suffix.lower() in IMAGE_SUFFIXES]
     if not paths:
-        raise ValueError(f"{folder} is not an OTB sequence: img/ holds no .jpg/.png images")
+        raise ValueError(f'{folder} is not an OTB sequence: img/ holds no .jpg/.png images')
     numbers = {p: _FRAME_NUMBER.search(p.stem) for p in paths}
     bad = [p.name for p, m in numbers.items() if m is None]
     if bad:
-        raise ValueError(f"{img_dir}: image names must end in their frame number, got {bad[0]!r}")
+        raise ValueError(f'{img_dir}: image names must end in their frame number, got {bad[0]!r}')
     paths.sort(key=lambda p: int(numbers[p].group(1)))
     return paths, [int(numbers[p].group(1)) for p in paths]
 
@@ -193,10 +237,14 @@ def _frames_of(folder: Path) -> tuple[list[Path], list[int]]:
 def _gt_files(folder: Path) -> dict[str, Path]:
     """Target name -> GT file of one sequence folder (Jogging -> Jogging-1, Jogging-2)."""
     multi = sorted(
-        ((int(m.group(1)), p) for p in folder.glob("groundtruth_rect.*.txt") if (m := _MULTI_GT.match(p.name))),
+        (
+            (int(m.group(1)), p)
+            for p in folder.glob('groundtruth_rect.*.txt')
+            if (m := _MULTI_GT.match(p.name))
+        ),
     )
     if multi:
-        return {f"{folder.name}-{k}": p for k, p in multi}
+        return {f'{folder.name}-{k}': p for k, p in multi}
     single = folder / GT_NAME
     if single.is_file():
         return {folder.name: single}
@@ -204,7 +252,8 @@ def _gt_files(folder: Path) -> dict[str, Path]:
 
 
 def is_sequence_folder(folder: str | Path) -> bool:
-    """Whether ``folder`` is an OTB sequence folder.
+    """
+    Whether ``folder`` is an OTB sequence folder.
 
     Parameters
     ----------
@@ -214,14 +263,17 @@ def is_sequence_folder(folder: str | Path) -> bool:
     Returns
     -------
     bool
-        True when it has an ``img/`` folder and a ``groundtruth_rect.txt`` (or ``groundtruth_rect.<k>.txt`` files).
+        True when it has an ``img/`` folder and a ``groundtruth_rect.txt`` (or
+        ``groundtruth_rect.<k>.txt`` files).
+
     """
     folder = Path(folder)
-    return (folder / "img").is_dir() and bool(_gt_files(folder))
+    return (folder / 'img').is_dir() and bool(_gt_files(folder))
 
 
 def list_sequences(root: str | Path) -> list[str]:
-    """Names of the OTB targets below ``root``, sorted (Jogging gives Jogging-1 and Jogging-2).
+    """
+    Names of the OTB targets below ``root``, sorted (Jogging gives Jogging-1 and Jogging-2).
 
     Parameters
     ----------
@@ -237,10 +289,11 @@ def list_sequences(root: str | Path) -> list[str]:
     ------
     ValueError
         If ``root`` is not a directory.
+
     """
     root = Path(root)
     if not root.is_dir():
-        raise ValueError(f"OTB root {root} is not a directory")
+        raise ValueError(f'OTB root {root} is not a directory')
     names = []
     for folder in sorted(p for p in root.iterdir() if p.is_dir()):
         if is_sequence_folder(folder):
@@ -249,16 +302,18 @@ def list_sequences(root: str | Path) -> list[str]:
 
 
 def shared_data() -> Path | None:
-    """``../shared/data`` beside the repository (or beside the working directory), if it exists.
+    """
+    ``../shared/data`` beside the repository (or beside the working directory), if it exists.
 
     Returns
     -------
     Path or None
         The folder; None when neither exists.
+
     """
     repository = Path(__file__).resolve().parents[2]
     for base in (repository, Path.cwd()):
-        cand = base.parent / "shared" / "data"
+        cand = base.parent / 'shared' / 'data'
         if cand.is_dir():
             return cand
     return None
@@ -267,17 +322,21 @@ def shared_data() -> Path | None:
 def default_root() -> Path | None:
     """``../shared/data/otb``, if it exists (:func:`shared_data`)."""
     data = shared_data()
-    return data / "otb" if data is not None and (data / "otb").is_dir() else None
+    return data / 'otb' if data is not None and (data / 'otb').is_dir() else None
 
 
 def default_roots() -> list[Path]:
-    """The folders of sequences in ``../shared/data`` that exist: ``otb`` and ``uav``."""
+    """Return the folders of sequences in ``../shared/data`` that exist: ``otb`` and ``uav``."""
     data = shared_data()
-    return [] if data is None else [data / g for g in ("otb", "uav") if (data / g).is_dir()]
+    return [] if data is None else [data / g for g in ('otb', 'uav') if (data / g).is_dir()]
 
 
 def _resolve(path_or_name: str | Path, root: str | Path | None) -> tuple[Path, str]:
-    """Find the folder and target name for a folder path, ``<folder>-<k>`` or a bare name under root."""
+    """
+    Find the folder and target name for a folder path.
+
+    ``<folder>-<k>`` or a bare name under root.
+    """
     p = Path(path_or_name)
     candidates = [p]
     if not p.is_absolute() and len(p.parts) == 1:
@@ -289,16 +348,20 @@ def _resolve(path_or_name: str | Path, root: str | Path | None) -> tuple[Path, s
         m = _TARGET_NAME.match(cand.name)
         if m and (cand.parent / m.group(1)).is_dir():
             return cand.parent / m.group(1), cand.name
-    raise ValueError(f"OTB sequence {path_or_name!s} not found" + (f" under {root}" if root else ""))
+    raise ValueError(
+        f'OTB sequence {path_or_name!s} not found' + (f' under {root}' if root else '')
+    )
 
 
 def load_sequence(path_or_name: str | Path, root: str | Path | None = None) -> Sequence:
-    """Load one target.
+    """
+    Load one target.
 
     Parameters
     ----------
     path_or_name : str or Path
-        A sequence folder, ``<folder>-<k>`` (one target of a multi-target folder) or a name under ``root``.
+        A sequence folder, ``<folder>-<k>`` (one target of a multi-target folder) or a name under
+        ``root``.
     root : str or Path, optional
         The OTB root of a bare name (default: :func:`default_root`).
 
@@ -310,17 +373,25 @@ def load_sequence(path_or_name: str | Path, root: str | Path | None = None) -> S
     Raises
     ------
     ValueError
-        When the sequence is not found or not an OTB sequence, names a target the folder does not hold, or has a number
-        of GT boxes other than its number of images.
+        When the sequence is not found or not an OTB sequence, names a target the folder does not
+        hold, or has a number of GT boxes other than its number of images.
+
     """
     folder, name = _resolve(path_or_name, root)
     paths, numbers = _frames_of(folder)
     gts = _gt_files(folder)
     if not gts:
-        raise ValueError(f"{folder} is not an OTB sequence: no {GT_NAME} (or groundtruth_rect.<k>.txt)")
+        raise ValueError(
+            f'{folder} is not an OTB sequence: no {GT_NAME} (or groundtruth_rect.<k>.txt)'
+        )
     if name not in gts:
-        raise ValueError(f"{folder} holds the targets {', '.join(gts)}; choose one of them, not {name!r}")
+        raise ValueError(
+            f'{folder} holds the targets {", ".join(gts)}; choose one of them, not {name!r}'
+        )
     boxes = parse_groundtruth(gts[name])
     if len(boxes) != len(paths):
-        raise ValueError(f"{gts[name]}: {len(boxes)} ground-truth boxes for {len(paths)} images in {folder / 'img'}")
+        raise ValueError(
+            f'{gts[name]}: {len(boxes)} ground-truth boxes for {len(paths)} images in '
+            f'{folder / "img"}'
+        )
     return Sequence(name, tuple(paths), boxes, tuple(numbers), folder.parent.name)

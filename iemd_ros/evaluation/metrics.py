@@ -1,22 +1,52 @@
-"""Tracking metrics of the OTB protocol (Wu, Lim & Yang 2013) used in the paper's evaluation.
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
-Boxes are ``(x, y, w, h)`` in 0-based continuous pixel coordinates (top-left corner + size).
-The paper's measure is the relative overlap ``|R_tr ∩ R_gt| / |R_tr ∪ R_gt|`` (Section "Experiments",
-overlap equation); its tables report the average overlap, the gyro experiment also the fraction of
-frames with overlap > 0 and > 40 %.  The OTB success plot / AUC and precision@20px are added so the
-figures compare with the rest of the field.
+"""
+Tracking metrics of the OTB protocol (Wu, Lim & Yang 2013) used in the paper's evaluation.
+
+Boxes are ``(x, y, w, h)`` in 0-based continuous pixel coordinates (top-left corner + size).  The
+paper's measure is the relative overlap ``|R_tr ∩ R_gt| / |R_tr ∪ R_gt|`` (Section
+"Experiments", overlap equation); its tables report the average overlap, the gyro experiment also
+the fraction of frames with overlap > 0 and > 40 %.  The OTB success plot / AUC and precision@20px
+are added so the figures compare with the rest of the field.
 
 All fractions are returned in [0, 1]; callers multiply by 100 for percentages.
 
 Conventions (the same as the OTB toolkit's ``calcRectInt`` / ``perfPlot``):
 
-* A box with a NaN coordinate or a non-positive width/height is *invalid*: its IoU with anything is 0
-  and its centre error is ``inf`` (a tracker failure counts as a miss at every threshold).
+* A box with a NaN coordinate or a non-positive width/height is *invalid*: its IoU with anything is
+  0 and its centre error is ``inf`` (a tracker failure counts as a miss at every threshold).
 * A ground-truth box that is invalid marks an *absent* frame; :func:`score_sequence` excludes such
   frames (OTB keeps only frames whose four annotation values are > 0 / finite).
 * The success curve counts ``overlap > t`` (strict), the precision counts ``error <= t`` px.
-* The OTB pixel-inclusive convention (``right = x + w - 1``, ``width = right - left + 1``) gives the
-  same intersection as the continuous one used here.
+* The OTB pixel-inclusive convention (``right = x + w - 1``, ``width = right - left + 1``) gives
+  the same intersection as the continuous one used here.
 """
 from __future__ import annotations
 
@@ -35,20 +65,23 @@ def _as_boxes(boxes, name: str) -> np.ndarray:
     if arr.ndim == 1:
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 4:
-        raise ValueError(f"{name} must be (x, y, w, h) or an (N, 4) array of boxes, got shape {np.shape(boxes)}")
+        raise ValueError(
+            f'{name} must be (x, y, w, h) or an (N, 4) array of boxes, got shape {np.shape(boxes)}'
+        )
     return arr
 
 
 def _pair(boxes_a, boxes_b) -> tuple[np.ndarray, np.ndarray]:
-    a = _as_boxes(boxes_a, "boxes_a")
-    b = _as_boxes(boxes_b, "boxes_b")
+    a = _as_boxes(boxes_a, 'boxes_a')
+    b = _as_boxes(boxes_b, 'boxes_b')
     if len(a) != len(b) and len(a) != 1 and len(b) != 1:
-        raise ValueError(f"boxes_a and boxes_b have different lengths: {len(a)} vs {len(b)}")
+        raise ValueError(f'boxes_a and boxes_b have different lengths: {len(a)} vs {len(b)}')
     return a, b
 
 
 def valid_boxes(boxes) -> np.ndarray:
-    """Boolean mask of boxes that are finite and have positive width and height.
+    """
+    Boolean mask of boxes that are finite and have positive width and height.
 
     Parameters
     ----------
@@ -64,14 +97,16 @@ def valid_boxes(boxes) -> np.ndarray:
     ------
     ValueError
         For other shapes.
+
     """
-    b = _as_boxes(boxes, "boxes")
-    with np.errstate(invalid="ignore"):
+    b = _as_boxes(boxes, 'boxes')
+    with np.errstate(invalid='ignore'):
         return np.isfinite(b).all(axis=1) & (b[:, 2] > 0) & (b[:, 3] > 0)
 
 
 def iou(boxes_a, boxes_b) -> np.ndarray:
-    """Relative overlap ``|A ∩ B| / |A ∪ B|`` of paired boxes (paper's overlap equation).
+    """
+    Relative overlap ``|A ∩ B| / |A ∪ B|`` of paired boxes (paper's overlap equation).
 
     Parameters
     ----------
@@ -87,10 +122,11 @@ def iou(boxes_a, boxes_b) -> np.ndarray:
     ------
     ValueError
         For other shapes, or different numbers of boxes.
+
     """
     a, b = _pair(boxes_a, boxes_b)
     ok = valid_boxes(a) & valid_boxes(b)
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid='ignore'):
         iw = np.minimum(a[:, 0] + a[:, 2], b[:, 0] + b[:, 2]) - np.maximum(a[:, 0], b[:, 0])
         ih = np.minimum(a[:, 1] + a[:, 3], b[:, 1] + b[:, 3]) - np.maximum(a[:, 1], b[:, 1])
         inter = np.clip(iw, 0.0, None) * np.clip(ih, 0.0, None)
@@ -100,7 +136,8 @@ def iou(boxes_a, boxes_b) -> np.ndarray:
 
 
 def center_error(boxes_a, boxes_b) -> np.ndarray:
-    """Euclidean distance in pixels between box centres.
+    """
+    Euclidean distance in pixels between box centres.
 
     Parameters
     ----------
@@ -116,12 +153,13 @@ def center_error(boxes_a, boxes_b) -> np.ndarray:
     ------
     ValueError
         For other shapes, or different numbers of boxes.
+
     """
     a, b = _pair(boxes_a, boxes_b)
     ok = valid_boxes(a) & valid_boxes(b)
     ca = a[:, :2] + a[:, 2:] / 2.0
     cb = b[:, :2] + b[:, 2:] / 2.0
-    with np.errstate(invalid="ignore"):
+    with np.errstate(invalid='ignore'):
         d = np.hypot(*(ca - cb).T)
     return np.where(ok, d, np.inf)
 
@@ -129,14 +167,17 @@ def center_error(boxes_a, boxes_b) -> np.ndarray:
 def _as_values(values, name: str) -> np.ndarray:
     arr = np.asarray(values, dtype=float).ravel()
     if arr.size == 0:
-        raise ValueError(f"{name} is empty: no frames to score")
+        raise ValueError(f'{name} is empty: no frames to score')
     if np.isnan(arr).any():
-        raise ValueError(f"{name} contains NaN (use iou()/center_error(), which map invalid boxes to 0/inf)")
+        raise ValueError(
+            f'{name} contains NaN (use iou()/center_error(), which map invalid boxes to 0/inf)'
+        )
     return arr
 
 
 def fraction_above(ious, thr: float) -> float:
-    """Fraction of frames whose overlap is strictly greater than ``thr`` (paper: overlap > 0, > 40 %).
+    """
+    Fraction of frames whose overlap is strictly greater than ``thr`` (paper: overlap > 0, > 40 %).
 
     Parameters
     ----------
@@ -154,12 +195,14 @@ def fraction_above(ious, thr: float) -> float:
     ------
     ValueError
         For no values, or NaN among them.
+
     """
-    return float(np.mean(_as_values(ious, "ious") > thr))
+    return float(np.mean(_as_values(ious, 'ious') > thr))
 
 
 def success_curve(ious, thresholds=OTB_THRESHOLDS) -> np.ndarray:
-    """OTB success plot: for each threshold t, the fraction of frames with overlap > t.
+    """
+    OTB success plot: for each threshold t, the fraction of frames with overlap > t.
 
     Parameters
     ----------
@@ -177,14 +220,16 @@ def success_curve(ious, thresholds=OTB_THRESHOLDS) -> np.ndarray:
     ------
     ValueError
         For no values, or NaN among them.
+
     """
-    v = _as_values(ious, "ious")
+    v = _as_values(ious, 'ious')
     t = np.asarray(thresholds, dtype=float).ravel()
     return (v[None, :] > t[:, None]).mean(axis=1)
 
 
 def success_auc(ious, thresholds=OTB_THRESHOLDS) -> float:
-    """OTB area under the success curve: the mean of the curve over the (21) thresholds.
+    """
+    OTB area under the success curve: the mean of the curve over the (21) thresholds.
 
     Parameters
     ----------
@@ -202,12 +247,14 @@ def success_auc(ious, thresholds=OTB_THRESHOLDS) -> float:
     ------
     ValueError
         For no values, or NaN among them.
+
     """
     return float(success_curve(ious, thresholds).mean())
 
 
 def precision_at(center_errors, thr: float = PRECISION_THRESHOLD) -> float:
-    """OTB precision: fraction of frames whose centre error is <= ``thr`` pixels.
+    """
+    OTB precision: fraction of frames whose centre error is <= ``thr`` pixels.
 
     Parameters
     ----------
@@ -225,12 +272,14 @@ def precision_at(center_errors, thr: float = PRECISION_THRESHOLD) -> float:
     ------
     ValueError
         For no values, or NaN among them.
+
     """
-    return float(np.mean(_as_values(center_errors, "center_errors") <= thr))
+    return float(np.mean(_as_values(center_errors, 'center_errors') <= thr))
 
 
 def average_overlap(ious) -> float:
-    """The paper's table metric: mean relative overlap over all (scored) frames.
+    """
+    Return the paper's table metric: mean relative overlap over all (scored) frames.
 
     Parameters
     ----------
@@ -246,13 +295,15 @@ def average_overlap(ious) -> float:
     ------
     ValueError
         For no values, or NaN among them.
+
     """
-    return float(np.mean(_as_values(ious, "ious")))
+    return float(np.mean(_as_values(ious, 'ious')))
 
 
 @dataclass
 class SequenceScores:
-    """All per-sequence figures of one tracker run (fractions in [0, 1]; ``fps`` may be None).
+    """
+    All per-sequence figures of one tracker run (fractions in [0, 1]; ``fps`` may be None).
 
     Parameters
     ----------
@@ -274,11 +325,12 @@ class SequenceScores:
         The run's speed.
     success_curve : list of float, optional
         The success curve at :data:`OTB_THRESHOLDS`.
+
     """
 
     name: str
-    n_frames: int          # frames scored (GT present)
-    n_absent: int          # frames excluded because the GT box is invalid / NaN
+    n_frames: int  # frames scored (GT present)
+    n_absent: int  # frames excluded because the GT box is invalid / NaN
     average_overlap: float
     success_auc: float
     precision_20: float
@@ -288,18 +340,23 @@ class SequenceScores:
     success_curve: list[float] = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        """The figures as a dict.
+        """
+        Return the figures as a dict.
 
         Returns
         -------
         dict
             Field name -> value (``dataclasses.asdict``).
+
         """
         return asdict(self)
 
 
-def score_sequence(pred_boxes, gt_boxes, name: str = "", fps: float | None = None) -> SequenceScores:
-    """Score predicted boxes against ground truth over the frames where the GT box is valid.
+def score_sequence(
+    pred_boxes, gt_boxes, name: str = '', fps: float | None = None
+) -> SequenceScores:
+    """
+    Score predicted boxes against ground truth over the frames where the GT box is valid.
 
     Parameters
     ----------
@@ -319,14 +376,17 @@ def score_sequence(pred_boxes, gt_boxes, name: str = "", fps: float | None = Non
     ------
     ValueError
         For boxes of other shapes or of different numbers, or no valid GT box.
+
     """
-    pred = _as_boxes(pred_boxes, "pred_boxes")
-    gt = _as_boxes(gt_boxes, "gt_boxes")
+    pred = _as_boxes(pred_boxes, 'pred_boxes')
+    gt = _as_boxes(gt_boxes, 'gt_boxes')
     if len(pred) != len(gt):
-        raise ValueError(f"{name or 'sequence'}: {len(pred)} predicted boxes for {len(gt)} ground-truth boxes")
+        raise ValueError(
+            f'{name or "sequence"}: {len(pred)} predicted boxes for {len(gt)} ground-truth boxes'
+        )
     present = valid_boxes(gt)
     if not present.any():
-        raise ValueError(f"{name or 'sequence'}: no frame has a valid ground-truth box")
+        raise ValueError(f'{name or "sequence"}: no frame has a valid ground-truth box')
     ov = iou(pred[present], gt[present])
     ce = center_error(pred[present], gt[present])
     curve = success_curve(ov)
@@ -346,18 +406,21 @@ def score_sequence(pred_boxes, gt_boxes, name: str = "", fps: float | None = Non
 
 #: A return counts as re-acquired once a reported box overlaps the target by at least this IoU.
 REACQUIRED_IOU = 0.3
-#: ... within this many frames of the target's return (the issue's "back on the target within 30 frames").
+#: ... within this many frames of the target's return (the issue's "back on the target within 30
+#: frames").
 REACQUIRE_WITHIN = 30
 
 
 @dataclass
 class LongTermScores:
-    """Figures of a run on a sequence where the target leaves the view (VOT's long-term measures).
+    """
+    Figures of a run on a sequence where the target leaves the view (VOT's long-term measures).
 
     Attributes
     ----------
     precision : float
-        Mean IoU over the frames where the tracker reports the target (a report on an absent target scores 0).
+        Mean IoU over the frames where the tracker reports the target (a report on an absent target
+        scores 0).
     recall : float
         Mean IoU over the frames where the target is present (a frame without report scores 0).
     f_score : float
@@ -369,9 +432,11 @@ class LongTermScores:
     returns : int
         Times the target came back into view (absent -> present).
     reacquired : int
-        Returns after which a reported box reached :data:`REACQUIRED_IOU` within :data:`REACQUIRE_WITHIN` frames.
+        Returns after which a reported box reached :data:`REACQUIRED_IOU` within
+        :data:`REACQUIRE_WITHIN` frames.
     delays : list of int
         Per return, frames from the return to the first such report (-1: never).
+
     """
 
     precision: float
@@ -388,7 +453,10 @@ class LongTermScores:
 
 
 def long_term_scores(pred_boxes, reported, gt_boxes) -> LongTermScores:
-    """VOT long-term precision, recall and F-score of a run, with the false reports and the re-acquisitions.
+    """
+    VOT long-term precision, recall and F-score of a run.
+
+    With the false reports and the re-acquisitions.
 
     Parameters
     ----------
@@ -407,25 +475,35 @@ def long_term_scores(pred_boxes, reported, gt_boxes) -> LongTermScores:
     ------
     ValueError
         For arrays of different lengths, or no present and no reported frame.
+
     """
-    pred = _as_boxes(pred_boxes, "pred_boxes")
-    gt = _as_boxes(gt_boxes, "gt_boxes")
+    pred = _as_boxes(pred_boxes, 'pred_boxes')
+    gt = _as_boxes(gt_boxes, 'gt_boxes')
     rep = np.asarray(reported, dtype=bool).ravel()
     if not len(pred) == len(gt) == len(rep):
-        raise ValueError(f"{len(pred)} boxes, {len(rep)} report flags and {len(gt)} GT boxes: lengths differ")
+        raise ValueError(
+            f'{len(pred)} boxes, {len(rep)} report flags and {len(gt)} GT boxes: lengths differ'
+        )
     rep = rep & valid_boxes(pred)
     present = valid_boxes(gt)
     ov = np.where(rep & present, iou(pred, gt), 0.0)
     if not present.any() and not rep.any():
-        raise ValueError("no frame where the target is present or reported: nothing to score")
+        raise ValueError('no frame where the target is present or reported: nothing to score')
     precision = float(ov[rep].mean()) if rep.any() else 0.0
     recall = float(ov[present].mean()) if present.any() else 0.0
     f = 2 * precision * recall / (precision + recall) if precision + recall > 0 else 0.0
     absent = ~present
     delays = []
     for start in np.flatnonzero(present[1:] & absent[:-1]) + 1:
-        window = np.flatnonzero(ov[start:start + REACQUIRE_WITHIN] >= REACQUIRED_IOU)
+        window = np.flatnonzero(ov[start: start + REACQUIRE_WITHIN] >= REACQUIRED_IOU)
         delays.append(int(window[0]) if window.size else -1)
-    return LongTermScores(precision=precision, recall=recall, f_score=f, absent_frames=int(absent.sum()),
-                          false_report_rate=float(rep[absent].mean()) if absent.any() else 0.0,
-                          returns=len(delays), reacquired=sum(d >= 0 for d in delays), delays=delays)
+    return LongTermScores(
+        precision=precision,
+        recall=recall,
+        f_score=f,
+        absent_frames=int(absent.sum()),
+        false_report_rate=float(rep[absent].mean()) if absent.any() else 0.0,
+        returns=len(delays),
+        reacquired=sum(d >= 0 for d in delays),
+        delays=delays,
+    )
