@@ -1,5 +1,6 @@
 """IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
 import dataclasses
+from concurrent.futures import Future
 
 import numpy as np
 import pytest
@@ -12,6 +13,7 @@ from iemd_ros.evaluation.metrics import iou
 from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.tracking.template import TemplateDictionary
 from iemd_ros.tracking.analysis import descend, search_context
+from iemd_ros.tracking import tracker as tracker_module
 from iemd_ros.tracking.tracker import MIN_SIDE_PX, Cause, _scale_bounds, _visible_fraction
 
 
@@ -371,3 +373,28 @@ def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
     overlaps = [float(iou(tracker.update(frame).box, seq.gt_boxes[k]).ravel()[0])
                 for k, frame in enumerate(frames[1:], start=1)]
     assert np.mean(overlaps) >= 0.75 and min(overlaps) >= 0.5, (np.mean(overlaps), min(overlaps))
+
+
+class _Inline:
+    """An executor that runs each job at once on the calling thread: the tracker's serial schedule."""
+
+    def submit(self, fn, *args):
+        future = Future()
+        future.set_result(fn(*args))
+        return future
+
+
+def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, monkeypatch):
+    seq = load_sequence(otb_root / "Woman")
+    frames = [read_frame(p) for p in seq.frame_paths[:25]]
+
+    def run():
+        tracker = IemdTracker()
+        tracker.init(frames[0], seq.gt_boxes[0])
+        return [tracker.update(frame) for frame in frames[1:]]
+
+    threaded = run()
+    monkeypatch.setattr(tracker_module, "_workers", lambda: _Inline())
+    serial = run()
+    assert [r.box for r in threaded] == [r.box for r in serial]
+    assert [r.emd for r in threaded] == [r.emd for r in serial]

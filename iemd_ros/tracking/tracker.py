@@ -11,6 +11,8 @@ models learn unless the frame is held or lost.
 from __future__ import annotations
 
 import enum
+import functools
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import cv2
@@ -31,6 +33,7 @@ __all__ = ["IemdTracker", "TrackResult", "Cause", "warm_up"]
 
 MIN_SIDE_PX = 4.0  # the scale search never shrinks a window's shorter side below this (image pixels)
 CONFIDENCE_RATE = 0.1  # learning rate of the running mean that update_confidence compares the response with
+WORKERS = 2  # threads the independent models of a frame run on (this machine class: 2 cores)
 FRAME_SEARCH_AFTER = 5  # lost frames searched only around the prediction before the whole frame is searched too
 
 
@@ -299,15 +302,17 @@ class IemdTracker:
         """(best descent, every search run, starts searched) from the prediction ``center``: the fine starts
         (flow, translation filter, colour model) and, when the frame looks lost, section 6.1's particles."""
         cfg = self.config
-        moves = []  # where the optical flow and the translation filter take the window (closer: the prediction's own)
-        if cfg.flow_start:
-            moves.append(window_flow(previous, grey, _box(self._center, self._size, self._angle), prior,
-                                     cfg.flow_max_error))
-        if self._translation_filter is not None:
-            moves.append(self._translation_filter.estimate(frame, center, size, angle))
+        # Where the flow, the translation filter and the colour model take the window: independent, so the flow and
+        # the colour model run on the worker threads while the filter runs here (their kernels release the GIL).
         self._colour_now = self._colour_model is not None and frame.ndim == 3
-        if self._colour_now:
-            moves.append(self._colour_model.estimate(frame, center, size, angle))
+        jobs = [_workers().submit(window_flow, previous, grey, _box(self._center, self._size, self._angle), prior,
+                                  cfg.flow_max_error)] if cfg.flow_start else []
+        colour = (_workers().submit(self._colour_model.estimate, frame, center, size, angle)
+                  if self._colour_now else None)
+        if self._translation_filter is not None:
+            jobs.append(self._translation_filter.estimate(frame, center, size, angle))
+        jobs += [colour] if colour is not None else []
+        moves = [job.result() if isinstance(job, Future) else job for job in jobs]
         fine_starts = [center + move for move in moves if move is not None and np.linalg.norm(move) >= cfg.min_step_px]
         best = self._search(pyramid, [center, *fine_starts], size, angle, center)
         searches, starts = [best], 1 + len(fine_starts)
@@ -335,15 +340,16 @@ class IemdTracker:
         if confidence is not None:
             self._confidence = confidence if self._confidence is None else (
                 (1.0 - CONFIDENCE_RATE) * self._confidence + CONFIDENCE_RATE * confidence)
-        if self._scale_filter is not None:
-            self._scale_filter.update(frame, center, size, angle)
+        learners = [model.update for model, on in ((self._scale_filter, self._scale_filter is not None),
+                                                   (self._colour_model, self._colour_now)) if on]
+        jobs = [_workers().submit(learn, frame, center, size, angle) for learn in learners]  # independent models
         if self._translation_filter is not None:
             self._translation_filter.update(frame, center, size, angle)
-        if self._colour_now:
-            self._colour_model.update(frame, center, size, angle)
         if self.config.update_templates and self.dictionary.observe(final.model.template, final.emd,
                                                                     self._frame_index):
             self._refresh_target()
+        for job in jobs:
+            job.result()
 
     def _context(self, pyramid: ImagePyramid, angle: float = 0.0) -> SearchContext:
         """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the current target model
@@ -515,6 +521,12 @@ def warm_up() -> None:
 
 
 # ---------------------------------------------------------------- helpers
+@functools.cache
+def _workers() -> ThreadPoolExecutor:
+    """The threads the models of one frame run on side by side, shared by every tracker of the process."""
+    return ThreadPoolExecutor(max_workers=WORKERS, thread_name_prefix="iemd-tracker")
+
+
 def _box(center, size, angle: float = 0.0):
     """Axis-aligned box (x, y, w, h) around the window, rotated by ``angle`` about its centre."""
     c, s = abs(np.cos(angle)), abs(np.sin(angle))
