@@ -27,9 +27,12 @@
 # ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
 # POSSIBILITY OF SUCH DAMAGE.
 
-"""Features (fHOG, Colour Names) and the correlation filters' shared pieces against hand-computed cases, and STRCF's
-ADMM against a direct solve of its objective."""
+"""
+Features (fHOG, Colour Names) and the correlation filters' shared pieces, and STRCF's ADMM.
 
+The features and shared pieces against hand-computed cases, and STRCF's ADMM against a direct
+solve of its objective.
+"""
 from iemd_ros.tracking import features as F
 from iemd_ros.tracking.correlation_filter import apce, gaussian_label, sample_region, SubCellPeak
 from iemd_ros.tracking.translation_filter import TranslationFilter
@@ -42,15 +45,14 @@ def _grey3(a):
     return np.repeat(np.clip(a, 0, 255).astype(np.uint8)[:, :, None], 3, axis=2)
 
 
-# ----------------------------------------------------------------------------------------------
-# fHOG
+# -------------------------------------------------------------------------------- fHOG
 def test_hog_of_a_ramp_by_hand():
     """
     I = 10 x: every gradient (10, 0), angle 0.
 
-    An interior cell: R1[0] = 10 (16 px x 10 / 16), the other bins 0; E = 100, block norm 1 /
-    sqrt(4 * 100) = 1/20, normalized 0.5, clipped 0.2: signed bin 0 = 0.5 * 4 * 0.2, unsigned bin 0
-    the same, texture 0.2357 * 0.2, the rest 0.
+    An interior cell: R1[0] = 10 (16 px x 10 / 16), the other bins 0; E = 100, block norm
+    1 / sqrt(4 * 100) = 1/20, normalized 0.5, clipped 0.2: signed bin 0 = 0.5 * 4 * 0.2, unsigned
+    bin 0 the same, texture 0.2357 * 0.2, the rest 0.
     """
     img = np.tile(np.arange(24, dtype=np.float32) * 10, (24, 1))
     h = F.fhog(img)
@@ -93,8 +95,7 @@ def test_hog_of_colour_takes_the_strongest_channel_and_a_flat_image_has_none():
     assert np.abs(F.fhog(np.full((16, 16), 77, np.float32))).max() == 0
 
 
-# ----------------------------------------------------------------------------------------------
-# Colour Names
+# -------------------------------------------------------------------------------- Colour Names
 def test_colour_names_cells_are_the_table_rows_of_their_pixels():
     """
     Row of a BGR pixel b, g, r: r // 8 + 32 (g // 8) + 1024 (b // 8).
@@ -132,8 +133,7 @@ def test_grey_frames_have_grey_and_hog_only():
     np.testing.assert_allclose(xg[1:], F.fhog(grey[:, :, 0]), atol=1e-6)
 
 
-# ----------------------------------------------------------------------------------------------
-# sampling, peak
+# -------------------------------------------------------------------------------- sampling, peak
 def test_sample_region_crops_exactly_and_turns_by_the_angle():
     rng = np.random.default_rng(1)
     img = rng.integers(0, 256, (60, 80, 3), dtype=np.uint8)
@@ -161,14 +161,13 @@ def test_the_sub_cell_peak_of_a_shifted_gaussian():
     assert abs(dy - dy0) < 0.02 and abs(dx - dx0) < 0.02 and apce(resp) > 10
 
 
-# ----------------------------------------------------------------------------------------------
-# STRCF's solver
+# -------------------------------------------------------------------------------- STRCF's solver
 def _tiny(rows, cols, C, seed=0):
     rng = np.random.default_rng(seed)
     x = rng.standard_normal((C, rows, cols))
     y = gaussian_label(rows, cols, 1.0).astype(np.float64)
     w2 = rng.uniform(0.0, 4.0, (rows, cols))
-    w2[rows // 2 - 1: rows // 2 + 1, cols // 2 - 1: cols // 2 + 1] = 1e-6
+    w2[rows // 2 - 1:rows // 2 + 1, cols // 2 - 1:cols // 2 + 1] = 1e-6
     f_prev = rng.standard_normal((C, rows, cols)) * 0.1
     tf = TranslationFilter()
     tf.map_hw, tf.T, tf.reg_sq = (rows, cols), rows * cols, w2
@@ -178,9 +177,9 @@ def _tiny(rows, cols, C, seed=0):
 
 def _correlation_matrix(x):
     """
-    Return a (T, C T) with (A f)(n) = sum_d sum_m f_d(m) x_d(m + n) (circular).
+    Return A, (T, C T), with (A f)(n) = sum_d sum_m f_d(m) x_d(m + n) (circular).
 
-    The response of f on x.
+    A f is the response of f on x.
     """
     C, R, Cc = x.shape
     T = R * Cc
@@ -188,14 +187,19 @@ def _correlation_matrix(x):
     for n in range(T):
         ny, nx = divmod(n, Cc)
         for d in range(C):
-            A[n, d * T: (d + 1) * T] = np.roll(np.roll(x[d], -ny, axis=0), -nx, axis=1).ravel()
+            A[n, d * T:(d + 1) * T] = np.roll(np.roll(x[d], -ny, axis=0), -nx, axis=1).ravel()
     return A
 
 
 @pytest.mark.parametrize('rows,cols', [(6, 6), (5, 7)])
 def test_admm_converges_to_the_direct_solve_of_strcf_objective(rows, cols):
-    """argmin 1/(2T) ||sum_d x_d * f_d - y||^2 + 1/2 sum_d ||w f_d||^2 + mu/2 sum_d ||f_d - f_prev||^2, by the
-    normal equations, against ADMM run long at a fixed penalty; and the response convention r = A f."""
+    """
+    The direct solve of STRCF's objective against ADMM run long at a fixed penalty.
+
+    The objective argmin 1/(2T) ||sum_d x_d * f_d - y||^2 + 1/2 sum_d ||w f_d||^2
+    + mu/2 sum_d ||f_d - f_prev||^2 is solved by the normal equations; and the response convention
+    r = A f.
+    """
     C, mu = 2, 0.7
     tf, x, y, w2, f_prev = _tiny(rows, cols, C)
     T = rows * cols
@@ -218,7 +222,7 @@ def test_the_first_f_step_is_the_per_frequency_solve():
     """
     One f-step from g = h = 0, mu = 0.
 
-    (x x^H + T gamma I) f = x conj(y) at every frequency (Sherman-Morrison).
+    It solves (x x^H + T gamma I) f = x conj(y) at every frequency (Sherman-Morrison).
     """
     rows, cols, C = 4, 6, 3
     tf, x, y, _, _ = _tiny(rows, cols, C)

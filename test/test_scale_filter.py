@@ -38,8 +38,12 @@ import pytest
 
 @pytest.mark.parametrize('angle', [0.0, 0.6])
 def test_recovers_a_known_scale_change_of_a_real_window(car4_first, angle):
-    """Learned on Car4's target, the filter measures the target against windows 10 % too small or too large
-    (1/0.9 = 1.111 and 1/1.1 = 0.909), and against a frame magnified by 6 %; with the window turned too."""
+    """
+    Learned on Car4's target, the filter measures the target against known scale changes.
+
+    Against windows 10 % too small or too large (1/0.9 = 1.111 and 1/1.1 = 0.909), and against a
+    frame magnified by 6 %; with the window turned too.
+    """
     frame, box = car4_first
     centre, size = box_centre(box), box[2:]
     sf = ScaleFilter()

@@ -131,7 +131,7 @@ def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
     """
     analysis.descend() converges from a start 3 px off on a shifted texture.
 
-    And the next update() gives exactly what a tracker that never descended gives.
+    The next update() then gives exactly what a tracker that never descended gives.
     """
     frame0 = texture(seed=1, blob=8)
     box = (130.0, 90.0, 48.0, 40.0)
@@ -235,7 +235,7 @@ def test_a_target_lost_before_any_frame_learned_stays_lost_frame_after_frame():
     """
     Lost on the first update (the prior moves the window off the image).
 
-    So no response has been learned to compare a re-detection with: the next lost frames are
+    No response has then been learned to compare a re-detection with: the next lost frames are
     reported lost, not a TypeError.
     """
     frame = texture(seed=3)
@@ -331,7 +331,11 @@ def test_reconstructed_template_removes_an_occluder():
 
 
 def test_template_update_rule():
-    """Algorithm 2: the latest template is replaced only when the current one outweighs its decayed weight."""
+    """
+    Algorithm 2's template update rule.
+
+    The latest template is replaced only when the current one outweighs its decayed weight.
+    """
     layout = PatchLayout((32, 32), (8, 8), 4)
     rng = np.random.default_rng(1)
     d = TemplateDictionary(
@@ -514,7 +518,7 @@ class _Inline:
     """
     An executor that runs each job at once on the calling thread.
 
-    The tracker's serial schedule.
+    It gives the tracker's serial schedule.
     """
 
     def submit(self, fn, *args):

@@ -27,8 +27,11 @@
 # ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
 # POSSIBILITY OF SUCH DAMAGE.
 
-"""The translation filter (STRCF, iemd_ros/tracking/translation_filter.py) and the tracker's use of its response."""
+"""
+The translation filter (STRCF) and the tracker's use of its response.
 
+The filter is iemd_ros/tracking/translation_filter.py.
+"""
 from helpers import shifted
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
@@ -136,9 +139,14 @@ def test_the_tracker_adds_the_filter_start_and_follows_a_shift(car4_first):
 
 
 def test_the_score_weighs_the_filter_response_against_the_emd(car4_first, monkeypatch):
-    """The search keeps the descended window of lowest EMD / background EMD - translation_weight x response.  A
-    stand-in filter points at a decoy 30 px right of the target's true move (9, -6) and responds only there: with a
-    negligible weight the EMD's window on the target is kept, with weight 1 the decoy's."""
+    """
+    The search's score weighs the filter's response against the EMD.
+
+    The search keeps the descended window of lowest EMD / background EMD - translation_weight x
+    response.  A stand-in filter points at a decoy 30 px right of the target's true move (9, -6)
+    and responds only there: with a negligible weight the EMD's window on the target is kept, with
+    weight 1 the decoy's.
+    """
     frame, box = car4_first
     moved = shifted(frame, 9.0, -6.0)
     decoy = box_centre(box) + [39.0, -6.0]

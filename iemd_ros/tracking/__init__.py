@@ -27,8 +27,11 @@
 # ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
 # POSSIBILITY OF SUCH DAMAGE.
 
-"""The ROS-free iEMD tracker (the paper's Algorithms 1-2 with discriminative models around them)."""
+"""
+The ROS-free iEMD tracker.
 
+The paper's Algorithms 1-2 with discriminative models around them.
+"""
 from iemd_ros.tracking.config import TrackerConfig
 from iemd_ros.tracking.tracker import Cause, IemdTracker, TrackResult
 

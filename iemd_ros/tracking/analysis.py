@@ -57,7 +57,7 @@ def search_context(
     """
     Return the context the tracker's search samples windows in on a frame.
 
-    Its current target model and dictionary.
+    The context is the tracker's current target model and dictionary.
 
     ``CandidateModel(search_context(tracker, pyramid), centre, size).emd()`` scores any window.
 

@@ -31,11 +31,11 @@
 Appearance sampling: target window -> fixed-size template -> local patches (section 4).
 
 Geometry conventions (0-based image pixels, pixel centres at integer coordinates): a window is its
-centre ``(cx, cy)`` and size ``(w, h)``.  Template pixel ``u`` (0..T-1) samples image point ``cx +
-(u - (T-1)/2) * w/T`` along the window's x axis, which a window turned by ``angle`` points along
-(cos, sin) (:meth:`ImagePyramid.sample`).  Patch positions ``c`` are the patch centres relative to
-the window centre in *normalized window units*: the window spans [-1, 1] on each axis, so
-positions, the spatial kernel and the spatial term of the ground distance do not depend on the
+centre ``(cx, cy)`` and size ``(w, h)``.  Template pixel ``u`` (0..T-1) samples image point
+``cx + (u - (T-1)/2) * w/T`` along the window's x axis, which a window turned by ``angle`` points
+along (cos, sin) (:meth:`ImagePyramid.sample`).  Patch positions ``c`` are the patch centres
+relative to the window centre in *normalized window units*: the window spans [-1, 1] on each axis,
+so positions, the spatial kernel and the spatial term of the ground distance do not depend on the
 target's size in pixels.
 """
 from __future__ import annotations
@@ -71,7 +71,7 @@ def to_gray(frame: np.ndarray) -> np.ndarray:
 
 def grey_levels(frame: np.ndarray, copy: bool = False) -> np.ndarray:
     """
-    HxW uint8 grey levels of a uint8 frame.
+    Return the HxW uint8 grey levels of a uint8 frame.
 
     Parameters
     ----------
@@ -133,8 +133,8 @@ def warp_window(
     Returns
     -------
     ndarray
-        The (Th, Tw) sample whose pixel u (0..T-1 per axis) is the image point ``centre + linear @
-        (u - (T-1)/2)``; parts outside the image replicate its border.
+        The (Th, Tw) sample whose pixel u (0..T-1 per axis) is the image point
+        ``centre + linear @ (u - (T-1)/2)``; parts outside the image replicate its border.
 
     """
     tw, th = (int(v) for v in out_size)
@@ -261,7 +261,11 @@ class ImagePyramid:
         return out.reshape(len(factors), int(th), int(tw))
 
     def _geometry(self, center, size, template_size, angle: float):
-        """(pyramid level, linear map of template pixels to that level's pixels, window centre there)."""
+        """
+        Return where a window is sampled: (pyramid level, linear map, window centre there).
+
+        The linear map takes template pixels to that level's pixels.
+        """
         tw, th = template_size
         sx, sy = size[0] / tw, size[1] / th
         level = int(np.floor(np.log2(max(min(sx, sy), 1.0))))
@@ -314,14 +318,14 @@ class PatchLayout:
 
     @property
     def cells(self) -> tuple[int, int]:
-        """Return number of patches per row and column of the template."""
+        """Return the number of patches per row and column of the template."""
         tw, th = self.template_size
         pw, ph = self.patch_size
         return (tw - pw) // self.step + 1, (th - ph) // self.step + 1
 
     def positions(self) -> np.ndarray:
         """
-        Normalize centres of the window's patches.
+        Return the normalized centres of the window's patches.
 
         Returns
         -------
@@ -346,14 +350,12 @@ class PatchLayout:
 
     def extract(self, template: np.ndarray) -> np.ndarray:
         """
-        Appearance vectors epsilon of a template's patches.
+        Appearance vectors epsilon of a template's patches (section 4).
 
-        The paper's "normalized pixel values" (section 4).
-
-        Each patch is brought to zero mean and unit norm, invariant to local brightness and
-        contrast; a patch whose standard deviation is below ``min_contrast`` is scaled as if it had
-        that contrast (a shorter vector), so flat patches do not amplify noise
-        (docs/decisions.md#patch-normalization).
+        They are the paper's "normalized pixel values": each patch is brought to zero mean and unit
+        norm, invariant to local brightness and contrast; a patch whose standard deviation is below
+        ``min_contrast`` is scaled as if it had that contrast (a shorter vector), so flat patches
+        do not amplify noise (docs/decisions.md#patch-normalization).
 
         Parameters
         ----------

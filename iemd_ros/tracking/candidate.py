@@ -199,11 +199,10 @@ class CandidateModel:
 
     def at(self, center, size=None) -> 'CandidateModel':
         """
-        Return the model in the same context.
+        Return the model at another window in the same context.
 
-        (frame, target, dictionary, orientation) at another window.
-
-        Algorithm 1's next iterate, or a scale variant when ``size`` is given.
+        The context is the frame, target, dictionary and orientation.  Algorithm 1's next iterate,
+        or a scale variant when ``size`` is given.
 
         Parameters
         ----------
@@ -223,7 +222,7 @@ class CandidateModel:
     @cached_property
     def patch_jacobian(self) -> np.ndarray:
         """
-        d epsilon / d(window shift along its axes), per template pixel, (N, d, 2).
+        Return d epsilon / d(window shift along its axes), per template pixel, (N, d, 2).
 
         Computed on first use: the descent needs it only where a step is accepted (rejected trials
         and scale variants need only the EMD).
@@ -314,10 +313,10 @@ class CandidateModel:
             - "paper": eq. (10), the duals times dw_C/dy (patches fixed, kernel moves);
             - "appearance": the derivative of the re-sampled model that Algorithm 1 evaluates (only
               at y = 0): when the window moves its patches are re-sampled, so d_uv changes through
-              epsilon_v(y); with the flow fixed (envelope theorem) dD*/dy = -2 alpha sum_v (sum_u
-              f_uv eps_u - w_v eps_v) . d eps_v/dy.  The pooled code weights also move with the
-              content; that term is left out (they change slowly and have no closed-form
-              derivative).
+              epsilon_v(y); with the flow fixed (envelope theorem)
+              dD*/dy = -2 alpha sum_v (sum_u f_uv eps_u - w_v eps_v) . d eps_v/dy.  The pooled
+              code weights also move with the content; that term is left out (they change slowly
+              and have no closed-form derivative).
 
         Returns
         -------
@@ -343,8 +342,8 @@ class CandidateModel:
                 )
             flow = solution.flow
             # Per image pixel along the window's axes the Jacobian scales by T / size, and per
-            # normalized unit by size / 2: together -2 alpha (T / 2) sum r . d eps / d(template
-            # px).
+            # normalized unit by size / 2: together
+            # -2 alpha (T / 2) sum r . d eps / d(template px).
             contraction = _appearance_contraction(
                 flow.T @ self.context.target.eps, flow.sum(0), keep, self.eps, self.patch_jacobian
             )
@@ -361,7 +360,7 @@ def _transport_cost(appearance_cost, keep, target_pos, pos, y, spatial_weight):
     """
     d_uv over the kept candidate bins.
 
-    Appearance part + spatial_weight ||c_u - (c_v - y)||^2.
+    d_uv = appearance part + spatial_weight ||c_u - (c_v - y)||^2.
     """
     n_t, n_c = appearance_cost.shape[0], keep.size
     cost = np.empty((n_t, n_c))

@@ -149,9 +149,11 @@ class ColourModel:
         self._beta = _beta(self._target, self._surroundings)
 
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
-        """Displacement to the window of highest mean beta in the search region around the predicted window.
+        """
+        Return the displacement to the window of highest mean beta in the search region.
 
-        The map of mean beta is kept for :meth:`score_at`.
+        The region is the one around the predicted window; the map of mean beta is kept for
+        :meth:`score_at`.
 
         Parameters
         ----------
@@ -173,6 +175,7 @@ class ColourModel:
         ------
         RuntimeError
             Before :meth:`init`.
+
         """
         if not self.trained:
             raise RuntimeError('ColourModel.estimate() called before init()')
@@ -233,7 +236,7 @@ class ColourModel:
         """
         rho_O and rho_B: the colour-bin fractions of the window and of its surroundings.
 
-        (the window grown by half its mean side, less the window).
+        The surroundings are the window grown by half its mean side, less the window.
         """
         size = np.asarray(size, dtype=np.float64)
         bins, scale = self._bin_indices(frame, center, size + 0.5 * (size[0] + size[1]), angle)
@@ -248,10 +251,10 @@ class ColourModel:
 
     def _bin_indices(self, frame, center, region, angle) -> tuple[np.ndarray, float]:
         """
-        Return the region (w, h) around ``center`` in the axes of a window turned by ``angle``.
+        Return the colour-bin indices of the region (w, h) around ``center``, and the scale.
 
-        Resampled (nearest neighbour) to at most ``model_area`` pixels, as colour-bin indices; and
-        the scale (model px per image px).
+        The region is taken in the axes of a window turned by ``angle`` and resampled (nearest
+        neighbour) to at most ``model_area`` pixels; the scale is model px per image px.
         """
         scale = min(1.0, np.sqrt(self.model_area / (region[0] * region[1])))
         out_size = [max(1, int(round(v * scale))) for v in region]

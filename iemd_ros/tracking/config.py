@@ -28,9 +28,9 @@
 # POSSIBILITY OF SUCH DAMAGE.
 
 """
-The tracker's parameters (:class:`TrackerConfig`), each declared once with its meaning.
+The tracker's parameters (:class:`TrackerConfig`).
 
-Unit and range.
+Each is declared once, with its meaning, unit and range.
 """
 from __future__ import annotations
 
@@ -75,7 +75,7 @@ class TrackerConfig:
     """
     Parameters of :class:`~iemd_ros.tracking.tracker.IemdTracker`.
 
-    (defaults: the ``default`` preset).
+    The defaults are those of the ``default`` preset.
 
     ``TrackerConfig.preset("paper")`` gives the system of the paper; see :data:`PRESETS`.
     """
@@ -287,20 +287,15 @@ class TrackerConfig:
         if patches > MAX_PATCHES or pixels > MAX_PATCH_PIXELS:
             raise ValueError(
                 f'tracker: template_size {list(self.template_size)}, patch_size '
-                f'{list(self.patch_size)} '
-                f'and patch_step {self.patch_step} code a window with {patches} patches of '
-                f'{pixels} pixels; at most {MAX_PATCHES} patches and {MAX_PATCH_PIXELS} pixels (a '
-                '96x96 '
-                f'template of 8x8 patches at step 4) keep an update within the watchdog'
+                f'{list(self.patch_size)} and patch_step {self.patch_step} code a window with '
+                f'{patches} patches of {pixels} pixels; at most {MAX_PATCHES} patches and '
+                f'{MAX_PATCH_PIXELS} pixels (a 96x96 template of 8x8 patches at step 4) keep an '
+                'update within the watchdog'
             )
 
     @classmethod
     def preset(cls, name: str) -> 'TrackerConfig':
-        """
-        Return the configuration of a named preset (:data:`PRESETS`).
-
-        ``default`` or ``paper``.
-        """
+        """Return the configuration of the preset ``default`` or ``paper`` (:data:`PRESETS`)."""
         if name not in PRESETS:
             raise ValueError(f'unknown tracker preset {name!r} (known: {", ".join(PRESETS)})')
         return importlib.import_module(f'iemd_ros.tracking.presets.{name}').parameters()
@@ -308,7 +303,7 @@ class TrackerConfig:
     @classmethod
     def from_dict(cls, values: dict) -> 'TrackerConfig':
         """
-        From plain values by field name (missing: defaults).
+        Build the configuration from plain values by field name (missing: defaults).
 
         ValueError for unknown names or bad values.
         """
@@ -319,8 +314,8 @@ class TrackerConfig:
 
     def to_dict(self) -> dict:
         """
-        Plain values by field name (choices as their strings).
+        Return plain values by field name (choices as their strings).
 
-        round-trips through :meth:`from_dict`.
+        They round-trip through :meth:`from_dict`.
         """
         return {k: (v.value if isinstance(v, Choice) else v) for k, v in asdict(self).items()}

@@ -46,21 +46,20 @@ import numpy as np
 __all__ = ['sample_region', 'hann_inner', 'gaussian_label', 'apce', 'SubCellPeak']
 
 
-# ----------------------------------------------------------------------------------------------
-# sampling
+# -------------------------------------------------------------------------------- sampling
 def sample_region(img: np.ndarray, centre, region_wh, out_wh, angle: float = 0.0) -> np.ndarray:
     """
     Return the region of ``region_wh`` (w, h) pixels centred on ``centre`` and turned by ``angle``.
 
-    Resampled to ``out_wh`` pixels; parts outside the image replicate its border.
+    It is resampled to ``out_wh`` pixels; parts outside the image replicate its border.
 
     Unturned (the usual case), the region is ``[round(cx) - w//2, round(cx) - w//2 + w)`` (STRCF's
-    ``get_pixels`` with its rounded sample position); shrinking by ``f >= 2`` first averages ``k x
-    k`` blocks, ``k = floor(f)`` (OpenCV's integer INTER_AREA; the region rounded to a multiple of
-    k), then resamples bilinearly by the remaining factor below 2, as the MATLAB trackers'
-    ``mexResize(..., 'auto')`` averages over areas.  A turned region (the gyro prior's camera roll)
-    is warped bilinearly from the image shrunk by ``pyrDown`` until the remaining factor is below
-    2, so that it is not aliased either.
+    ``get_pixels`` with its rounded sample position); shrinking by ``f >= 2`` first averages
+    ``k x k`` blocks, ``k = floor(f)`` (OpenCV's integer INTER_AREA; the region rounded to a
+    multiple of k), then resamples bilinearly by the remaining factor below 2, as the MATLAB
+    trackers' ``mexResize(..., 'auto')`` averages over areas.  A turned region (the gyro prior's
+    camera roll) is warped bilinearly from the image shrunk by ``pyrDown`` until the remaining
+    factor is below 2, so that it is not aliased either.
 
     Parameters
     ----------
@@ -117,7 +116,11 @@ def _axis_aligned(img, centre, region_wh, ow: int, oh: int) -> np.ndarray:
 
 
 def _crop(img, x0: int, y0: int, sw: int, sh: int) -> np.ndarray:
-    """Integer crop ``[x0, x0 + sw) x [y0, y0 + sh)`` with the border pixels replicated outside the image."""
+    """
+    Integer crop ``[x0, x0 + sw) x [y0, y0 + sh)`` of ``img``.
+
+    Outside the image its border pixels are replicated.
+    """
     H, W = img.shape[:2]
     x1, y1 = x0 + sw, y0 + sh
     if x0 >= 0 and y0 >= 0 and x1 <= W and y1 <= H:
@@ -132,13 +135,12 @@ def _crop(img, x0: int, y0: int, sw: int, sh: int) -> np.ndarray:
     return img[iy[:, None], ix[None, :]]
 
 
-# ----------------------------------------------------------------------------------------------
-# windows, labels
+# -------------------------------------------------------------------------------- windows, labels
 def hann_inner(n: int) -> np.ndarray:
     """
     Hann window of length ``n`` without its zero end points.
 
-    (``hann(n + 2)(2:end-1)`` of BACF/AutoTrack).
+    It is ``hann(n + 2)(2:end-1)`` of BACF/AutoTrack.
     """
     k = np.arange(1, n + 1)
     return (0.5 - 0.5 * np.cos(2 * np.pi * k / (n + 1))).astype(np.float32)
@@ -146,22 +148,21 @@ def hann_inner(n: int) -> np.ndarray:
 
 def gaussian_label(rows: int, cols: int, sigma: float) -> np.ndarray:
     """
-    Gaussian of std ``sigma`` (cells) with its peak at index (0, 0).
+    Gaussian of std ``sigma`` (cells) with its peak at index (0, 0), wrapped circularly.
 
-    Wrapped circularly (KCF/STRCF).
+    As in KCF/STRCF.
     """
     ry = np.roll(np.arange(rows) - (rows - 1) // 2, -((rows - 1) // 2))
     rx = np.roll(np.arange(cols) - (cols - 1) // 2, -((cols - 1) // 2))
     return np.exp(-0.5 * (ry[:, None] ** 2 + rx[None, :] ** 2) / sigma**2).astype(np.float32)
 
 
-# ----------------------------------------------------------------------------------------------
-# confidence
+# -------------------------------------------------------------------------------- confidence
 def apce(resp: np.ndarray) -> float:
     """
     Average peak-to-correlation energy ``|F_max - F_min|^2 / mean((F - F_min)^2)``.
 
-    (LMCF, CVPR 2017, eq. 11).
+    From LMCF (CVPR 2017), eq. 11.
     """
     mx, mn = float(resp.max()), float(resp.min())
     den = float(np.mean((resp - mn) ** 2))
@@ -172,10 +173,10 @@ class SubCellPeak:
     """
     The response's maximum refined by Newton's method on its Fourier interpolant.
 
-    (SRDCF, Danelljan et al., ICCV 2015, sec. 4.2), from the rfft2 half spectrum ``R``.
+    As SRDCF does (Danelljan et al., ICCV 2015, sec. 4.2), from the rfft2 half spectrum ``R``.
 
-    ``r(Y, X) = 1/T Re sum c_kx R(ky, kx) exp(i (ky Y + kx X))`` with ``Y = 2 pi y / rows``, ``X =
-    2 pi x / cols`` and ``c_kx = 2`` for the frequencies whose conjugate is not stored.
+    ``r(Y, X) = 1/T Re sum c_kx R(ky, kx) exp(i (ky Y + kx X))`` with ``Y = 2 pi y / rows``,
+    ``X = 2 pi x / cols`` and ``c_kx = 2`` for the frequencies whose conjugate is not stored.
 
     Parameters
     ----------
@@ -199,9 +200,9 @@ class SubCellPeak:
 
     def __call__(self, resp: np.ndarray, rf: np.ndarray) -> tuple[float, float, float]:
         """
-        ``(dy, dx, value)``: the peak's displacement in cells from the origin.
+        ``(dy, dx, value)``: the peak's displacement in cells from the origin, and its value.
 
-        (signed, circular) and the interpolated response there.
+        The displacement is signed and circular; the value is the interpolated response there.
         """
         rows, cols = self.rows, self.cols
         idx = int(np.argmax(resp))
@@ -225,7 +226,11 @@ class SubCellPeak:
 
 
 def _vertex(left: float, centre: float, right: float) -> float:
-    """Offset in (-0.5, 0.5) of the vertex of the parabola through three samples around their maximum."""
+    """
+    Offset in (-0.5, 0.5) of the vertex of the parabola through three samples.
+
+    The samples lie around their maximum.
+    """
     den = left - 2.0 * centre + right
     return float(np.clip(0.5 * (left - right) / den, -0.5, 0.5)) if den < 0 else 0.0
 
@@ -235,7 +240,7 @@ def _newton(R, ky, kx, c, Y, X, iterations):
     """
     Newton iterations on ``F(Y, X) = Re sum_ab R_ab c_b exp(i (ky_a Y + kx_b X))``.
 
-    (Y, X, F(Y, X)).
+    Returns (Y, X, F(Y, X)).
     """
     H, Wh = R.shape
     ex = np.empty(Wh, np.complex128)
@@ -269,8 +274,7 @@ def _newton(R, ky, kx, c, Y, X, iterations):
     return Y, X, v
 
 
-# ----------------------------------------------------------------------------------------------
-# spectral kernels
+# -------------------------------------------------------------------------------- spectral kernels
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def energy(xf, out):
     """``out[i, j] = sum_d |xf[d, i, j]|^2``."""

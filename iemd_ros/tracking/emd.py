@@ -87,7 +87,7 @@ def ground_distance(eps_t, pos_t, eps_c, pos_c, alpha: float) -> np.ndarray:
     """
     Ground distance d_uv = alpha ||eps_u - eps_v||^2 + (1 - alpha) ||c_u - c_v||^2.
 
-    (eq. ground distance).
+    The paper's eq. (ground distance).
 
     Parameters
     ----------
@@ -117,7 +117,7 @@ def appearance_distance(eps_t, eps_c, sq_norms_t=None) -> np.ndarray:
     """
     Squared appearance distances ||eps_u - eps_v||^2 for all pairs.
 
-    (rows of ``eps_t`` x rows of ``eps_c``).
+    The pairs are rows of ``eps_t`` x rows of ``eps_c``.
 
     Parameters
     ----------

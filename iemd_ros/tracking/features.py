@@ -70,7 +70,7 @@ def colour_names() -> np.ndarray:
     """
     Return the (32768, 10) float32 Colour Names table.
 
-    (``data/colour_names.npy``, see ``data/README.md``).
+    It is loaded from ``data/colour_names.npy`` (see ``data/README.md``).
     """
     return np.ascontiguousarray(
         np.load(Path(__file__).with_name('data') / 'colour_names.npy'), dtype=np.float32
@@ -79,8 +79,12 @@ def colour_names() -> np.ndarray:
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _atan2_pos(y, x):
-    """``atan2(y, x)`` mapped to [0, 2 pi): octant reduction + a degree-7 odd polynomial for atan on [0, 1]
-    (max error 2e-4 rad = 0.01 deg, far below the 20 deg bin width; Piotr's toolbox also uses a table)."""
+    """
+    ``atan2(y, x)`` mapped to [0, 2 pi).
+
+    Octant reduction + a degree-7 odd polynomial for atan on [0, 1] (max error 2e-4 rad = 0.01 deg,
+    far below the 20 deg bin width; Piotr's toolbox also uses a table).
+    """
     ax = abs(x)
     ay = abs(y)
     mx = max(ax, ay)
@@ -102,10 +106,10 @@ def _atan2_pos(y, x):
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _grad_bins(img, cell, O0, M0):
     """
-    Per pixel: the nearest of 18 orientation bins ``O0`` and the vote ``M0``.
+    Per pixel: the nearest of 18 orientation bins ``O0`` and the vote ``M0`` (magnitude / cell^2).
 
-    (magnitude / cell^2) of the colour channel of largest gradient (centred differences, one-sided
-    at the border).
+    Both are those of the colour channel of largest gradient (centred differences, one-sided at
+    the border).
     """
     H, W, C = img.shape
     norm = 1.0 / (cell * cell)
@@ -172,7 +176,7 @@ def _fhog_into(img, cell, clip, out, off):
     """
     Write the 31 fHOG channels of ``img`` (H, W, C) float32 into ``out[off:off+31]``.
 
-    (see module doc).
+    See the module docstring.
     """
     H, W, C = img.shape
     hb = H // cell
@@ -277,7 +281,12 @@ def fhog(img: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _colour_into(bgr, cell, table, use_cn, out, grey_ch, cn_off):
-    """Per-cell mean of grey/255 - 0.5 into ``out[grey_ch]`` and of the CN table rows into ``out[cn_off:+10]``."""
+    """
+    Write the per-cell means of grey and of the CN table rows into ``out``.
+
+    The mean of grey/255 - 0.5 goes into ``out[grey_ch]``, that of the CN table rows into
+    ``out[cn_off:+10]``.
+    """
     H, W, C = bgr.shape
     hb = H // cell
     wb = W // cell
@@ -310,7 +319,7 @@ def _colour_into(bgr, cell, table, use_cn, out, grey_ch, cn_off):
 
 
 def n_channels(colour: bool) -> int:
-    """Return number of channels :func:`extract` returns: 42 on colour frames, 32 on grey ones."""
+    """Return how many channels :func:`extract` returns: 42 on colour frames, 32 on grey ones."""
     return 1 + N_HOG + (N_CN if colour else 0)
 
 
@@ -320,7 +329,7 @@ def extract(
     """
     Grey + fHOG (+ Colour Names on colour frames) of a uint8 patch.
 
-    ``(C, H // cell, W // cell)`` float32.
+    The map is ``(C, H // cell, W // cell)`` float32.
 
     Parameters
     ----------
@@ -360,9 +369,9 @@ def _fhog_batch(patches, cell, clip, out):
 
 def fhog_batch(patches: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
     """
-    fHOG of K equally sized patches ``(K, H, W[, C])`` in one call.
+    Return the fHOG of K equally sized patches ``(K, H, W[, C])`` in one call.
 
-    ``(K, 31, H // cell, W // cell)`` float32.
+    The maps are ``(K, 31, H // cell, W // cell)`` float32.
     """
     p = np.ascontiguousarray(patches, dtype=np.float32)
     if p.ndim == 3:

@@ -54,10 +54,12 @@ _LK = {'winSize': (11, 11), 'maxLevel': 3}
 
 def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarray | None = None,
                 max_error: float = 2.0) -> np.ndarray | None:
-    """Median motion of the content of ``box`` from ``previous`` into ``current`` beyond what ``prior`` predicts.
+    """
+    Median motion of the content of ``box`` from ``previous`` into ``current``, beyond ``prior``.
 
-    The window's predicted centre plus the returned residual is the flow's starting point.  Only a region around the
-    window and its prediction is processed (one window size of margin), so the cost does not grow with the frame.
+    The motion is the residual beyond what ``prior`` predicts: the window's predicted centre plus
+    the returned residual is the flow's starting point.  Only a region around the window and its
+    prediction is processed (one window size of margin), so the cost does not grow with the frame.
 
     Parameters
     ----------
@@ -66,16 +68,17 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     box : array_like
         (x, y, w, h) in ``previous``.
     prior : ndarray, optional
-        The 3x3 homography from ``previous`` into ``current`` pixels (the gyro prediction), which seeds the
-        Lucas-Kanade search.
+        The 3x3 homography from ``previous`` into ``current`` pixels (the gyro prediction), which
+        seeds the Lucas-Kanade search.
     max_error : float, optional
         Forward-backward error, px, above which a point is dropped.
 
     Returns
     -------
     ndarray or None
-        (dx, dy) in px; None when too few points can be followed, when ``prior`` takes the window out of the image
-        (or to infinity), or for frames of different sizes.
+        (dx, dy) in px; None when too few points can be followed, when ``prior`` takes the window
+        out of the image (or to infinity), or for frames of different sizes.
+
     """
     if previous.shape != current.shape:
         return None
@@ -103,7 +106,7 @@ def window_flow(previous: np.ndarray, current: np.ndarray, box, prior: np.ndarra
     # Corners are searched in the window only; it lies inside the region, so its size check covers
     # both.
     bx0, by0 = max(int(np.floor(x)), 0), max(int(np.floor(y)), 0)
-    window = previous[by0: max(int(np.ceil(y + h)), by0), bx0: max(int(np.ceil(x + w)), bx0)]
+    window = previous[by0:max(int(np.ceil(y + h)), by0), bx0:max(int(np.ceil(x + w)), bx0)]
     if min(window.shape) < 8:
         return None
     points = cv2.goodFeaturesToTrack(window, N_POINTS, 0.01, 3)

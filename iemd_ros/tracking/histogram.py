@@ -30,11 +30,11 @@
 """
 Kernel-weighted histograms of sparse codes.
 
-eqs. (sparse target model) and (sparse candidate model).
+Those of eqs. (sparse target model) and (sparse candidate model).
 
 Bin r carries the pooled code weight ``p_r`` (or ``q_r``) of patch r and the Epanechnikov profile
-``k(x) = max(0, 1 - x)`` of its squared normalized distance to the window centre, ``x = ||(c_r - y)
-/ h||^2``.
+``k(x) = max(0, 1 - x)`` of its squared normalized distance to the window centre,
+``x = ||(c_r - y) / h||^2``.
 
 Section 4's index u of ``p_ru`` is read as: every patch is a bin, with its own appearance and
 position in the ground distance (docs/decisions.md#histogram-bins).  Positions are in normalized
@@ -53,7 +53,7 @@ def target_weights(code_weights: np.ndarray, pos: np.ndarray, bandwidth: float) 
     """
     Target histogram w_T,u = gamma k(||c_u/h||^2) |p_u|.
 
-    Normalized to sum 1 (eq. sparse target model).
+    It is normalized to sum 1 (eq. sparse target model).
 
     The candidate weights of the same patches with the kernel at the window centre (y = 0).
 

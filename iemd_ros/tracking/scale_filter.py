@@ -33,14 +33,14 @@ Discriminative scale estimation: fDSST's one-dimensional correlation filter over
 The EMD of the iEMD histograms hardly changes with the window's scale: its patch positions are in
 normalized window units and its patches are normalized, so a window somewhat too large or too small
 scores almost the same EMD (docs/decisions.md#scale-estimator).  This is the scale filter of fDSST
-(Danelljan, Hager, Shahbaz Khan, Felsberg, "Discriminative Scale Space Tracking", TPAMI 2017, sec.
-4-5): ``N_SCALES`` samples of the window at sizes ``step^e_k`` (``e_k`` spaced by ``N_INTERP /
-N_SCALES`` interpolated steps) resampled to one model size of area ``MODEL_AREA`` and described by
-fHOG, one column per scale times a Hann window over the scales; a 1-D filter over the scales (eqs.
-5-6; the template a running average at ``LEARNING_RATE``, eq. 21), its response zero-padded to
-``N_INTERP`` scales (sec. 5.3) and the peak refined by a parabola (ECO-HC).  fDSST's QR compression
-to ``N_SCALES`` dimensions (eqs. 22-23) leaves the response unchanged; it is computed exactly from
-a Gram matrix instead.
+(Danelljan, Hager, Shahbaz Khan, Felsberg, "Discriminative Scale Space Tracking", TPAMI 2017,
+sec. 4-5): ``N_SCALES`` samples of the window at sizes ``step^e_k`` (``e_k`` spaced by
+``N_INTERP / N_SCALES`` interpolated steps) resampled to one model size of area ``MODEL_AREA`` and
+described by fHOG, one column per scale times a Hann window over the scales; a 1-D filter over the
+scales (eqs. 5-6; the template a running average at ``LEARNING_RATE``, eq. 21), its response
+zero-padded to ``N_INTERP`` scales (sec. 5.3) and the peak refined by a parabola (ECO-HC).  fDSST's
+QR compression to ``N_SCALES`` dimensions (eqs. 22-23) leaves the response unchanged; it is
+computed exactly from a Gram matrix instead.
 """
 from __future__ import annotations
 
@@ -91,7 +91,11 @@ class ScaleFilter:
         self._last = None
 
     def init(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
-        """Fix the model size (the first window's, scaled to ``MODEL_AREA``) and learn on the first window."""
+        """
+        Fix the model size and learn on the first window.
+
+        The model size is the first window's, scaled to ``MODEL_AREA``.
+        """
         w, h = float(size[0]), float(size[1])
         f = np.sqrt(MODEL_AREA / (w * h))
         self.model_wh = (max(int(np.floor(w * f)), 8), max(int(np.floor(h * f)), 8))
@@ -104,7 +108,7 @@ class ScaleFilter:
         """
         Return the relative scale of the target at the window (``center``, ``size``, ``angle``).
 
-        Within ``bounds`` (lowest, highest).
+        The scale is kept within ``bounds`` (lowest, highest).
         """
         if self.template is None:
             raise RuntimeError('ScaleFilter.estimate() needs init() first')
@@ -131,7 +135,7 @@ class ScaleFilter:
         """
         Learn on the scale samples of the window (``center``, ``size``, ``angle``) of ``frame``.
 
-        (eqs. 5-6, 21).
+        See eqs. 5-6, 21.
         """
         x = self._sample(frame, center, size, angle)
         denominator = np.real(self._correlation_f(x, x))
@@ -145,8 +149,8 @@ class ScaleFilter:
         """
         DFT over the scales of ``c(m) = sum_k sum_d a~_d(k) b~_d(k + m)``.
 
-        (``~``: times the scale window), from the Gram matrix ``a~^T b~``: the QR-compressed
-        correlation of fDSST, which it equals.
+        ``~`` is times the scale window.  Computed from the Gram matrix ``a~^T b~``: the
+        QR-compressed correlation of fDSST, which it equals.
         """
         G = (a.T @ b) * (self.window[:, None] * self.window[None, :])
         return np.fft.fft(G[self._diagonals].sum(axis=1))
@@ -201,7 +205,7 @@ def _parabola_peak(xs: np.ndarray, ys: np.ndarray) -> float:
     """
     Return the maximum of the parabola through three (scale, response) points, within their range.
 
-    The middle scale when the parabola opens upward or the system is singular.
+    It is the middle scale when the parabola opens upward or the system is singular.
     """
     A = np.stack([xs**2, xs, np.ones(3)], axis=1)
     try:

@@ -35,9 +35,10 @@ eq. (lagrange)::
 
     min_a ||epsilon - Phi a||_2^2 + lambda ||a||_1   s.t.  a >= 0
 
-solved exactly by an active set (Lawson-Hanson on the quadratic program ``a'Ga - 2(b -
-lambda/2)'a``, numba), so the KKT conditions hold to rounding; the Cholesky factor of the active
-block is extended by a row per entering atom (docs/decisions.md#sparse-coding-solver).
+solved exactly by an active set (Lawson-Hanson on the quadratic program
+``a'Ga - 2(b - lambda/2)'a``, numba), so the KKT conditions hold to rounding; the Cholesky factor
+of the active block is extended by a row per entering atom
+(docs/decisions.md#sparse-coding-solver).
 """
 from __future__ import annotations
 
@@ -50,7 +51,7 @@ def _factor_append(chol, order, k, j, gram, ridge):
     """
     Extend the lower Cholesky factor of G[order[:k], order[:k]] + ridge I by atom j.
 
-    (row/column k).
+    Atom j becomes its row/column k.
     """
     d = gram[j, j] + ridge
     for r in range(k):
@@ -65,7 +66,7 @@ def _factor_append(chol, order, k, j, gram, ridge):
 
 @numba.njit(cache=True)
 def _factor_solve(chol, order, k, b, z):
-    """z = (L L')^-1 b[order[:k]] (forward then back substitution)."""
+    """Solve for z = (L L')^-1 b[order[:k]] (forward then back substitution)."""
     for i in range(k):
         v = b[order[i]]
         for p in range(i):
@@ -168,7 +169,7 @@ class SparseCoder:
     """
     Codes patch vectors against a fixed dictionary by the non-negative lasso of eq. (lagrange).
 
-    Gram matrix cached.
+    The Gram matrix is cached.
 
     Parameters
     ----------
@@ -211,7 +212,9 @@ class SparseCoder:
             hold to rounding).
 
         """
-        correlations = np.ascontiguousarray(self.dictionary.T @ np.asarray(signals, dtype=np.float64))
+        correlations = np.ascontiguousarray(
+            self.dictionary.T @ np.asarray(signals, dtype=np.float64)
+        )
         return _active_set_lasso(self.gram, correlations, self.lam, self.tol, 1e-10)
 
 

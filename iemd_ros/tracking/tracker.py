@@ -27,17 +27,20 @@
 # ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
 # POSSIBILITY OF SUCH DAMAGE.
 
-"""The iEMD tracker: Algorithm 1 with the extensions of sections 5.1 and 6.1 and discriminative models around it.
+"""
+The iEMD tracker.
+
+Algorithm 1 with the extensions of sections 5.1 and 6.1 and discriminative models around it.
 
 OpenCV-style API: ``init(frame, box)`` then ``update(frame, prior=None)``.
 
-Per frame: the starts (the prediction, the optical flow's, the translation filter's and the colour model's
-windows) are scored; the best by EMD and the best by the search's score are descended (Algorithm 1: build the
-candidate model at the window, solve the EMD, move against its gradient while it decreases); the descended window
-of lower score is kept, preferring one the occlusion check accepts; then the scale is estimated at it, and the
-models learn unless the frame is held or lost.
+Per frame: the starts (the prediction, the optical flow's, the translation filter's and the colour
+model's windows) are scored; the best by EMD and the best by the search's score are descended
+(Algorithm 1: build the candidate model at the window, solve the EMD, move against its gradient
+while it decreases); the descended window of lower score is kept, preferring one the occlusion
+check accepts; then the scale is estimated at it, and the models learn unless the frame is held or
+lost.
 """
-
 from __future__ import annotations
 
 from concurrent.futures import Future, ThreadPoolExecutor
@@ -86,7 +89,8 @@ class Cause(enum.Enum):
     OUT_OF_VIEW = 'out of view'
     # the window no longer looks like the target
     EMD_ABOVE_BACKGROUND = "EMD above the background's"
-    LOW_RESPONSE = 'low filter response'  # held: the occlusion check
+    # held: the occlusion check
+    LOW_RESPONSE = 'low filter response'
     # the filter's peak far below its running mean
     NO_PEAK = 'no filter peak'
     # found again while lost (not learned from)
@@ -388,8 +392,12 @@ class IemdTracker:
         )
 
     def _peak_check(self, threshold: float) -> tuple[Cause | None, str]:
-        """(NO_PEAK, reason) when the translation filter's peak near the prediction is below ``threshold`` times the
-        running mean of its response on learned frames (LCT's re-detection trigger), else (None, "")."""
+        """
+        (NO_PEAK, reason) when the translation filter's peak near the prediction is too low.
+
+        Too low: below ``threshold`` times the running mean of its response on learned frames
+        (LCT's re-detection trigger).  Else (None, "").
+        """
         if self._translation_filter is None or self._confidence is None:
             return None, ''
         peak = self._translation_filter.response_peak
@@ -404,9 +412,9 @@ class IemdTracker:
         self, frame, pyramid, size, angle, predicted, starts: int, codings: int
     ) -> TrackResult | None:
         """
-        Return a lost frame the local search did not confirm.
+        Re-detect the target on a lost frame the local search did not confirm.
 
-        The filter searched where the target was lost (that place moved by the priors since), then,
+        The filter searches where the target was lost (that place moved by the priors since), then,
         lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near where it
         happened), one strip of the whole frame (the frame is scanned over lost frames) refined by
         a search at its peak.  The result when the best peak reaches ``found_response`` times the
@@ -451,12 +459,13 @@ class IemdTracker:
             codings=codings + 1,
             predicted_box=predicted,
             cause=Cause.REDETECTED,
-            reason=f're-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running '
-            'mean',
+            reason=(
+                f're-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean'
+            ),
         )
 
     def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float]:
-        """(where the translation filter's response peaks in the region around ``at``, its value)."""
+        """(centre, value) of the translation filter's peak in its search region around ``at``."""
         tf = self._translation_filter
         return at + tf.estimate(frame, at, size, angle), tf.response_peak
 
@@ -569,7 +578,7 @@ class IemdTracker:
         """
         Return the search context of windows turned by ``angle`` on ``pyramid``'s frame.
 
-        The current target model and dictionary.
+        It holds the current target model and dictionary.
         """
         cfg = self.config
         return SearchContext(
@@ -595,9 +604,13 @@ class IemdTracker:
         return previous, grey, ImagePyramid(to_gray(grey))
 
     def _confidence_check(self, center) -> tuple[float | None, str]:
-        """(the translation filter's response at the window centre ``center``, why the frame is held: "" when
-        it learns).  Held: the response is below ``update_confidence`` times its running mean over the frames that
-        learned (docs/decisions.md#occlusion-check).  (None, "") without the filter or the check."""
+        """
+        Return (the filter's response at the window centre ``center``, why the frame is held).
+
+        The filter is the translation filter; the reason is "" when the frame learns.  Held: the
+        response is below ``update_confidence`` times its running mean over the frames that learned
+        (docs/decisions.md#occlusion-check).  (None, "") without the filter or the check.
+        """
         threshold = self.config.update_confidence
         if self._translation_filter is None or threshold == 0:
             return None, ''
@@ -606,17 +619,16 @@ class IemdTracker:
             return confidence, ''
         return confidence, (
             f'models not updated: filter response {confidence:.3f} < {threshold} x its running '
-            'mean '
-            f'{self._confidence:.3f} (occlusion?)'
+            f'mean {self._confidence:.3f} (occlusion?)'
         )
 
     def _lost_reason(
         self, emd: float, center, size, angle: float, shape
     ) -> tuple[Cause | None, str]:
         """
-        (cause, reason) when the window.
+        (cause, reason) when the window (``center``, ``size``, ``angle``) counts as lost.
 
-        (``center``, ``size``, ``angle``) of EMD ``emd`` counts as lost, else (None, "").
+        ``emd`` is the window's EMD; (None, "") when the window does not count as lost.
         """
         cfg = self.config
         visible = _visible_fraction(center, size, angle, shape)
@@ -695,7 +707,7 @@ class IemdTracker:
         """
         Whether this frame's score has terms besides the EMD.
 
-        The translation filter's, the colour model's.
+        Those are the translation filter's and the colour model's.
         """
         return self._translation_filter is not None or self._colour_now
 
@@ -757,13 +769,13 @@ class IemdTracker:
         self, state: _Descent, bounds: tuple[float, float]
     ) -> tuple[_Descent, float]:
         """
-        Return the paper's scale variants at the converged centre.
+        Search the paper's scale variants at the converged centre (section 6.1).
 
-        (section 6.1: the window enlarged and shrunk by ``scale_step``), stepping on in each
-        direction while the EMD decreases, up to ``scale_range``, never leaving ``bounds``
-        (:func:`_scale_bounds`).  Each variant is the window resampled at s * size, so its patch
-        layout is the target's and its EMD compares with the EMD at scale 1.  Returns the chosen
-        window (its ``codings`` and ``warnings`` those of the variants) and its relative scale.
+        The window is enlarged and shrunk by ``scale_step``, stepping on in each direction while
+        the EMD decreases, up to ``scale_range``, never leaving ``bounds`` (:func:`_scale_bounds`).
+        Each variant is the window resampled at s * size, so its patch layout is the target's and
+        its EMD compares with the EMD at scale 1.  Returns the chosen window (its ``codings`` and
+        ``warnings`` those of the variants) and its relative scale.
         """
         cfg = self.config
         chosen = _Descent(model=state.model, emd=state.emd)
@@ -790,7 +802,7 @@ def warm_up() -> None:
     """
     Compile the tracker's numba kernels now (or load them from numba's on-disk cache).
 
-    So that the first frames of a node or a replay are not spent compiling.
+    Then the first frames of a node or a replay are not spent compiling.
     """
     frame = (np.random.default_rng(0).random((64, 64)) * 255).astype(np.uint8)
     tracker = IemdTracker()
@@ -804,7 +816,7 @@ def _workers() -> ThreadPoolExecutor:
     """
     Return the threads the models of one frame run on side by side.
 
-    Shared by every tracker of the process.
+    They are shared by every tracker of the process.
     """
     return ThreadPoolExecutor(max_workers=WORKERS, thread_name_prefix='iemd-tracker')
 
@@ -831,9 +843,9 @@ def _scale_bounds(size, shape) -> tuple[float, float]:
 
 def _not_optimal(solution) -> int:
     """
-    1 if an EMD solve ended without an optimal flow (counted in TrackResult.solver_warnings).
+    1 if an EMD solve ended without an optimal flow, else 0.
 
-    Else 0.
+    Counted in TrackResult.solver_warnings.
     """
     return int(solution is not None and not solution.optimal)
 
@@ -843,7 +855,7 @@ def _wrap_angle(angle: float) -> float:
 
 
 def _particle_offsets(n: int, distance: float) -> np.ndarray:
-    """n starting offsets (in window sizes) evenly around the prediction."""
+    """Return n starting offsets (in window sizes) evenly around the prediction."""
     angles = 2.0 * np.pi * np.arange(n) / max(n, 1)
     return distance * np.column_stack([np.cos(angles), np.sin(angles)])
 
@@ -869,8 +881,8 @@ def _apply_prior(H: np.ndarray, center, size):
     """
     Move the window by the homography.
 
-    Centre mapped, size scaled by sqrt|det J| of H there, and the turn (radians) of J's rotation
-    part, which the window's orientation follows.
+    Returns the centre mapped, the size scaled by sqrt|det J| of H there, and the turn (radians) of
+    J's rotation part, which the window's orientation follows.
 
     The turn is what keeps a camera roll from misaligning the window with the
     target (the CMU desk sequence rolls the eagle's head by up to 180 degrees).
@@ -890,8 +902,8 @@ def _is_colour(frame: np.ndarray) -> bool:
     """
     Whether ``frame`` has colour.
 
-    Three channels that are not all equal (grey sequences are often stored as BGR images with three
-    equal channels).
+    Colour: three channels that are not all equal (grey sequences are often stored as BGR images
+    with three equal channels).
     """
     return frame.ndim == 3 and not (
         np.array_equal(frame[..., 0], frame[..., 1])

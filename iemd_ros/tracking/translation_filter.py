@@ -43,21 +43,20 @@ complementary view (docs/decisions.md#strcf).
   the window, resampled so that its area lies in ``[150^2, 160^2]`` px (at most 40 x 40 cells); a
   cosine window; a Gaussian label of std ``sqrt(w h) / cell / 16`` cells.
 * Filter: STRCF (Li, Tian, Zuo, Zhang, Yang, "Learning Spatial-Temporal Regularized Correlation
-  Filters for Visual Tracking", CVPR 2018).  Each learning frame minimizes (STRCF eq. 3) ``E(f) =
-  1/(2T) ||sum_d x_d (*) f_d - y||^2 + 1/2 sum_d ||w . f_d||^2 + mu/2 sum_d ||f_d - f_{t-1,d}||^2``
-  with the binary window ``w`` of BACF (Kiani Galoogahi et al., ICCV 2017): ``1e-3`` on the
-  target's cells, ``1e5`` elsewhere, so that every circular shift of the padded sample is a real
-  background negative.  ADMM on ``f = g`` (STRCF eqs. 5-10), 2 iterations: the f-step per frequency
-  by Sherman-Morrison (eq. 8), the g-step element-wise in space (eq. 9), the multiplier update (eq.
-  10).  The training sample is the detection sample circularly shifted to the new centre in the
-  Fourier domain (AutoTrack's ``shift_sample``).
+  Filters for Visual Tracking", CVPR 2018).  Each learning frame minimizes (STRCF eq. 3)
+  ``E(f) = 1/(2T) ||sum_d x_d (*) f_d - y||^2 + 1/2 sum_d ||w . f_d||^2
+  + mu/2 sum_d ||f_d - f_{t-1,d}||^2`` with the binary window ``w`` of BACF (Kiani Galoogahi et
+  al., ICCV 2017): ``1e-3`` on the target's cells, ``1e5`` elsewhere, so that every circular shift
+  of the padded sample is a real background negative.  ADMM on ``f = g`` (STRCF eqs. 5-10), 2
+  iterations: the f-step per frequency by Sherman-Morrison (eq. 8), the g-step element-wise in
+  space (eq. 9), the multiplier update (eq. 10).  The training sample is the detection sample
+  circularly shifted to the new centre in the Fourier domain (AutoTrack's ``shift_sample``).
 * Detection: the response ``r = F^-1(sum_d conj(f_d^) z_d^)`` on the cell grid, its peak refined by
   Newton's method on the Fourier interpolant (SRDCF); :meth:`TranslationFilter.response_at` reads
   it at any window centre.
 """
 from __future__ import annotations
 
-import cv2
 from iemd_ros.tracking import features
 from iemd_ros.tracking.appearance import window_axes
 from iemd_ros.tracking.correlation_filter import (
@@ -146,10 +145,9 @@ class TranslationFilter:
     # ------------------------------------------------------------------ detection
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
         """
-        Where the response of the current filter peaks.
+        Displacement (dx, dy) px from ``center`` to where the current filter's response peaks.
 
-        As a displacement (dx, dy) px from ``center``; the response is kept for
-        :meth:`response_at`, its peak value in :attr:`response_peak`.
+        The response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
 
         Parameters
         ----------
@@ -177,13 +175,18 @@ class TranslationFilter:
         self._detection = (id(frame), pos, scale, angle, zf)
         self._response = (resp, pos, cell_px, window_axes(angle))
         self.response_peak = value
-        return window_axes(angle) @ (np.array([dx, dy]) * cell_px) + pos - np.asarray(center, dtype=np.float64)
+        return (
+            window_axes(angle) @ (np.array([dx, dy]) * cell_px)
+            + pos
+            - np.asarray(center, dtype=np.float64)
+        )
 
     def response_at(self, point) -> float:
         """
         Return the last :meth:`estimate`'s response at the window centre ``point`` (image px).
 
-        Interpolated bilinearly between cells (the response is circular over the search region).
+        It is interpolated bilinearly between cells (the response is circular over the search
+        region).
         """
         if self._response is None:
             raise RuntimeError('TranslationFilter.response_at() needs an estimate() first')
@@ -197,7 +200,7 @@ class TranslationFilter:
         """
         Where in one part of ``frame`` the filter responds most.
 
-        At the scale of a window of ``size``.
+        The filter is taken at the scale of a window of ``size``.
 
         The frame is resampled to the filter's scale and cut into vertical strips of at most
         ``FRAME_SEARCH_CELLS`` feature cells; the strip's features are correlated with the spatial
@@ -257,7 +260,7 @@ class TranslationFilter:
             self._frame_filter = (self.f, shape, np.conj(sfft.rfft2(h, s=shape, axes=(1, 2))))
         resp_f = np.sum(self._frame_filter[2] * sfft.rfft2(z, s=shape, axes=(1, 2)), axis=0)
         resp = np.roll(sfft.irfft2(resp_f, s=shape), (c0, c0), axis=(0, 1))[
-            : cells[0], first - lo: first - lo + width
+            :cells[0], first - lo:first - lo + width
         ]
         k = np.unravel_index(int(np.argmax(resp)), resp.shape)
         centre = (
@@ -314,16 +317,15 @@ class TranslationFilter:
         mu: float = MU,
     ):
         """
-        STRCF's ADMM (eqs.
+        Run STRCF's ADMM (eqs. 5-10) on one sample spectrum ``xf``, from ``g = h = 0``.
 
-        5-10) on one sample spectrum ``xf`` (C, rows, cols//2+1), from ``g = h = 0``.
-
-        Per iteration with penalty ``gamma`` (``gamma <- min(step gamma, max)``): the f-step (eq.
-        8) ``f^ = q + x^ (conj(y^) - x^H q) / (T (gamma + mu) + x^H x^)``, ``q = (gamma g^ - h^ +
-        mu f^_{t-1}) / (gamma + mu)``; the g-step (eq. 9) ``g = (gamma f + h) / (w^2 + gamma)``;
-        the multiplier (eq. 10) ``h^ += gamma (f^ - g^)``.  The last iteration stops after its
-        f-step, so 2 iterations cost one inverse and one forward FFT.  ``mu`` is 0 on the first
-        frame (no previous filter ``f_prev``).
+        ``xf`` is (C, rows, cols//2+1).  Per iteration with penalty ``gamma``
+        (``gamma <- min(step gamma, max)``): the f-step (eq. 8)
+        ``f^ = q + x^ (conj(y^) - x^H q) / (T (gamma + mu) + x^H x^)``,
+        ``q = (gamma g^ - h^ + mu f^_{t-1}) / (gamma + mu)``; the g-step (eq. 9)
+        ``g = (gamma f + h) / (w^2 + gamma)``; the multiplier (eq. 10) ``h^ += gamma (f^ - g^)``.
+        The last iteration stops after its f-step, so 2 iterations cost one inverse and one forward
+        FFT.  ``mu`` is 0 on the first frame (no previous filter ``f_prev``).
         """
         mu = 0.0 if f_prev is None else mu
         g_now, g_step, g_max = gamma
@@ -407,9 +409,9 @@ def _bilinear_circular(resp: np.ndarray, y: float, x: float) -> float:
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _f_step(xf, yfc, dinv, g, h, fp, cg, ch, cp, use_q, out, xq):
     """
-    STRCF's f-step (eq.
+    Compute STRCF's f-step (eq. 8) per frequency.
 
-    8) per frequency: ``q = cg g - ch h + cp fp``, ``f = q + x (conj(y) - x^H q) dinv``.
+    ``q = cg g - ch h + cp fp``, ``f = q + x (conj(y) - x^H q) dinv``.
     """
     C, H, W = xf.shape
     if not use_q:

@@ -30,5 +30,5 @@
 """
 Named tracker configurations, one module per variant.
 
-Each with ``parameters() -> TrackerConfig``.
+Each module has ``parameters() -> TrackerConfig``.
 """
