@@ -32,8 +32,8 @@ What the ament lint tests (test_flake8, test_pep257, test_copyright) check.
 
 Every .py file of the repository.
 
-Left out: folders starting with '.' or '_' (as ament's linters do), the build outputs that pip and
-colcon leave in the source tree, and PENDING.
+Left out: folders starting with '.' or '_' (as ament's linters do) and the build outputs that pip
+and colcon leave in the source tree.
 """
 from __future__ import annotations
 
@@ -45,26 +45,15 @@ REPO = Path(__file__).resolve().parents[1]
 # when the repository is the workspace; out/ holds benchmark and evaluation outputs.
 BUILD_OUTPUTS = ('build', 'install', 'log', 'out')
 
-# Files being reworked on another branch while the lint fixes landed.  They are brought in line
-# when that work lands (the lint fix script, then the hand fixes the linters still ask for), and
-# removed from here.
-PENDING = (
-    'iemd_ros/tracking',
-    'test/test_correlation_filter.py',
-    'test/test_scale_filter.py',
-    'test/test_tracker.py',
-    'test/test_translation_filter.py',
-)
-
 
 def excluded_paths() -> list[str]:
-    """Absolute paths of the build outputs and PENDING, for the linters' ``--exclude``."""
-    return [str(REPO / p) for p in BUILD_OUTPUTS + PENDING]
+    """Absolute paths of the build outputs, for the linters' ``--exclude``."""
+    return [str(REPO / p) for p in BUILD_OUTPUTS]
 
 
 def python_files() -> list[Path]:
     """Every .py file the lint tests check, sorted."""
-    skip = [REPO / p for p in BUILD_OUTPUTS + PENDING]
+    skip = [REPO / p for p in BUILD_OUTPUTS]
     files = []
     for path in REPO.rglob('*.py'):
         rel = path.relative_to(REPO)

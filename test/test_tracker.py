@@ -1,41 +1,69 @@
-"""IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
-import dataclasses
-from concurrent.futures import Future
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
+"""IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
+from concurrent.futures import Future
+import dataclasses
+
+from helpers import rotated, shifted, texture
+from iemd_ros import IemdTracker, TrackerConfig
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.datasets.otb import load_sequence, read_frame
+from iemd_ros.evaluation.metrics import iou
+from iemd_ros.tracking import tracker as tracker_module
+from iemd_ros.tracking.analysis import descend, search_context
+from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
+from iemd_ros.tracking.template import TemplateDictionary
+from iemd_ros.tracking.tracker import _scale_bounds, _visible_fraction, Cause, MIN_SIDE_PX
 import numpy as np
 import pytest
-from helpers import rotated, shifted, texture
-
-from iemd_ros import IemdTracker, TrackerConfig
-from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
-from iemd_ros.common.boxes import box_centre
-from iemd_ros.evaluation.metrics import iou
-from iemd_ros.datasets.otb import load_sequence, read_frame
-from iemd_ros.tracking.template import TemplateDictionary
-from iemd_ros.tracking.analysis import descend, search_context
-from iemd_ros.tracking import tracker as tracker_module
-from iemd_ros.tracking.tracker import MIN_SIDE_PX, Cause, _scale_bounds, _visible_fraction
 
 
-@pytest.mark.parametrize("bad,match", [
-    (np.zeros((0, 10), np.uint8), "empty"),
-    (np.zeros((10, 10), np.float32), "uint8"),
-    (np.zeros((10, 10, 4), np.uint8), "HxW"),
-    ([[1, 2], [3, 4]], "numpy"),
+@pytest.mark.parametrize('bad,match', [
+    (np.zeros((0, 10), np.uint8), 'empty'),
+    (np.zeros((10, 10), np.float32), 'uint8'),
+    (np.zeros((10, 10, 4), np.uint8), 'HxW'),
+    ([[1, 2], [3, 4]], 'numpy'),
 ])
 def test_invalid_frames_raise_value_error(bad, match):
     with pytest.raises(ValueError, match=match):
         IemdTracker().init(bad, (1, 1, 4, 4))
 
 
-@pytest.mark.parametrize("box,match", [
-    ((10, 10, 0, 5), "positive size"),
-    ((10, 10, 5, -1), "positive size"),
-    ((400, 10, 20, 20), "outside"),
-    ((-50, 10, 20, 20), "outside"),
-    ((np.nan, 10, 20, 20), "non-finite"),
-    ((1, 2, 3), "4 numbers"),
-    ("10,10,20,20", "4 numbers"),   # text is iemd-replay's --init to parse, not the tracker's
+@pytest.mark.parametrize('box,match', [
+    ((10, 10, 0, 5), 'positive size'),
+    ((10, 10, 5, -1), 'positive size'),
+    ((400, 10, 20, 20), 'outside'),
+    ((-50, 10, 20, 20), 'outside'),
+    ((np.nan, 10, 20, 20), 'non-finite'),
+    ((1, 2, 3), '4 numbers'),
+    ('10,10,20,20', '4 numbers'),   # text is iemd-replay's --init to parse, not the tracker's
 ])
 def test_invalid_boxes_raise_value_error(box, match):
     with pytest.raises(ValueError, match=match):
@@ -45,27 +73,38 @@ def test_invalid_boxes_raise_value_error(box, match):
 def test_invalid_prior_and_call_order():
     frame = texture()
     tracker = IemdTracker()
-    with pytest.raises(RuntimeError, match="before init"):
+    with pytest.raises(RuntimeError, match='before init'):
         tracker.update(frame)
-    with pytest.raises(RuntimeError, match="needs an initialized tracker"):
+    with pytest.raises(RuntimeError, match='needs an initialized tracker'):
         search_context(tracker, ImagePyramid(to_gray(frame)))
     tracker.init(frame, (100, 80, 40, 40))
-    for prior, match in [(np.eye(2), "3x3"), (np.full((3, 3), np.nan), "non-finite"), (np.zeros((3, 3)), "singular")]:
+    for prior, match in [
+        (np.eye(2), '3x3'),
+        (np.full((3, 3), np.nan), 'non-finite'),
+        (np.zeros((3, 3)), 'singular'),
+    ]:
         with pytest.raises(ValueError, match=match):
             tracker.update(frame, prior=prior)
 
 
 def test_invalid_config_is_rejected():
-    for kwargs in [dict(alpha=1.5), dict(lam=0), dict(gradient="newton"), dict(patch_size=(40, 40)),
-                   dict(scale_step=0.7), dict(motion_weight=-0.1), dict(update_confidence=1.0),
-                   dict(update_confidence=-0.1)]:
+    for kwargs in [
+        {'alpha': 1.5},
+        {'lam': 0},
+        {'gradient': 'newton'},
+        {'patch_size': (40, 40)},
+        {'scale_step': 0.7},
+        {'motion_weight': -0.1},
+        {'update_confidence': 1.0},
+        {'update_confidence': -0.1},
+    ]:
         with pytest.raises(ValueError):
             TrackerConfig(**kwargs)
-    with pytest.raises(ValueError, match="unknown tracker parameters: bogus"):
-        TrackerConfig.from_dict({"bogus": 1})
+    with pytest.raises(ValueError, match='unknown tracker parameters: bogus'):
+        TrackerConfig.from_dict({'bogus': 1})
 
 
-@pytest.mark.parametrize("dx,dy", [(2.4, -1.7), (-2.6, 0.8), (0.6, 2.3)])
+@pytest.mark.parametrize('dx,dy', [(2.4, -1.7), (-2.6, 0.8), (0.6, 2.3)])
 def test_recovers_a_known_subpixel_translation_of_a_texture(dx, dy):
     frame0 = texture(seed=1, blob=8)
     box = (130.0, 90.0, 48.0, 40.0)
@@ -73,7 +112,9 @@ def test_recovers_a_known_subpixel_translation_of_a_texture(dx, dy):
     tracker.init(frame0, box)
     result = tracker.update(shifted(frame0, dx, dy))
     assert not result.lost
-    assert abs(result.box[0] - (box[0] + dx)) < 0.5 and abs(result.box[1] - (box[1] + dy)) < 0.5, result.box
+    assert abs(result.box[0] - (box[0] + dx)) < 0.5 and abs(result.box[1] - (box[1] + dy)) < 0.5, (
+        result.box
+    )
 
 
 def test_recovers_a_translation_of_a_real_texture(car4_first):
@@ -81,12 +122,17 @@ def test_recovers_a_translation_of_a_real_texture(car4_first):
     tracker = IemdTracker(TrackerConfig(scale_step=0, update_templates=False))
     tracker.init(frame0, (x, y, w, h))
     result = tracker.update(shifted(frame0, 3.3, -2.2))
-    assert abs(result.box[0] - (x + 3.3)) < 0.75 and abs(result.box[1] - (y - 2.2)) < 0.75, result.box
+    assert abs(result.box[0] - (x + 3.3)) < 0.75 and abs(result.box[1] - (y - 2.2)) < 0.75, (
+        result.box
+    )
 
 
 def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
-    """analysis.descend() converges from a start 3 px off on a shifted texture, and the next update() gives exactly
-    what a tracker that never descended gives."""
+    """
+    analysis.descend() converges from a start 3 px off on a shifted texture.
+
+    The next update() then gives exactly what a tracker that never descended gives.
+    """
     frame0 = texture(seed=1, blob=8)
     box = (130.0, 90.0, 48.0, 40.0)
     frame1 = shifted(frame0, 2.4, -1.7)
@@ -94,13 +140,15 @@ def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
     probed.init(frame0, box)
     untouched.init(frame0, box)
     result = descend(probed, frame1, (box[0] + 2.4 - 3.0, box[1] - 1.7 + 1.0, 48.0, 40.0))
-    assert abs(result.box[0] - (box[0] + 2.4)) < 0.5 and abs(result.box[1] - (box[1] - 1.7)) < 0.5, result.box
+    assert (
+        abs(result.box[0] - (box[0] + 2.4)) < 0.5 and abs(result.box[1] - (box[1] - 1.7)) < 0.5
+    ), result.box
     assert result.box[2:] == (48.0, 40.0) and result.iterations > 0 and not result.lost
     assert result.codings == 1 + result.iterations  # the start and each trial step
     assert probed.update(frame1) == untouched.update(frame1)
-    with pytest.raises(RuntimeError, match="needs an initialized tracker"):
+    with pytest.raises(RuntimeError, match='needs an initialized tracker'):
         descend(IemdTracker(), frame1, box)
-    with pytest.raises(ValueError, match="outside"):
+    with pytest.raises(ValueError, match='outside'):
         descend(probed, frame1, (-80.0, 10.0, 20.0, 20.0))
 
 
@@ -109,8 +157,13 @@ def test_prior_moves_the_start_of_the_search():
     frame0 = texture(seed=2)
     box = (130.0, 90.0, 40.0, 40.0)
     frame1 = shifted(frame0, 25.0, 0.0)
-    config = TrackerConfig(scale_step=0, n_particles=0, flow_start=False, translation_weight=0.0,
-                           update_templates=False)
+    config = TrackerConfig(
+        scale_step=0,
+        n_particles=0,
+        flow_start=False,
+        translation_weight=0.0,
+        update_templates=False,
+    )
     without = IemdTracker(config)
     without.init(frame0, box)
     with_prior = IemdTracker(config)
@@ -135,15 +188,24 @@ def test_window_sampled_at_an_angle_undoes_an_image_rotation():
 
 
 def test_rotation_prior_turns_the_window_and_keeps_the_target():
-    """A 70 degree camera roll about a point off the target: with the exact prior the
-    window follows the target and turns with it; its box is the rotated window's bounding box."""
+    """
+    A 70 degree camera roll about a point off the target.
+
+    With the exact prior the window follows the target and turns with it; its box is the rotated
+    window's bounding box.
+    """
     frame0 = texture(seed=5)
     box = (130.0, 90.0, 50.0, 30.0)
     pivot, theta = np.array([150.0, 130.0]), np.deg2rad(70.0)
     frame1 = rotated(frame0, pivot, 70.0)
     c, s = np.cos(theta), np.sin(theta)
-    H = np.array([[c, -s, pivot[0] - c * pivot[0] + s * pivot[1]],
-                  [s, c, pivot[1] - s * pivot[0] - c * pivot[1]], [0, 0, 1]])
+    H = np.array(
+        [
+            [c, -s, pivot[0] - c * pivot[0] + s * pivot[1]],
+            [s, c, pivot[1] - s * pivot[0] - c * pivot[1]],
+            [0, 0, 1],
+        ]
+    )
     config = TrackerConfig(scale_step=0, n_particles=0, update_templates=False)
     tracker = IemdTracker(config)
     tracker.init(frame0, box)
@@ -162,15 +224,20 @@ def test_target_leaving_the_image_is_reported_lost():
     frame = texture(seed=3)
     tracker = IemdTracker()
     tracker.init(frame, (2.0, 100.0, 40.0, 40.0))
-    H = np.array([[1, 0, -60.0], [0, 1, 0], [0, 0, 1]])  # the camera turned: the scene moved 60 px left
+    # the camera turned: the scene moved 60 px left
+    H = np.array([[1, 0, -60.0], [0, 1, 0], [0, 0, 1]])
     moved = np.concatenate([frame[:, 60:], texture(seed=4)[:, :60]], axis=1)
     result = tracker.update(moved, prior=H)
-    assert result.lost and "inside the image" in result.reason
+    assert result.lost and 'inside the image' in result.reason
 
 
 def test_a_target_lost_before_any_frame_learned_stays_lost_frame_after_frame():
-    """Lost on the first update (the prior moves the window off the image), so no response has been learned to
-    compare a re-detection with: the next lost frames are reported lost, not a TypeError."""
+    """
+    Lost on the first update (the prior moves the window off the image).
+
+    No response has then been learned to compare a re-detection with: the next lost frames are
+    reported lost, not a TypeError.
+    """
     frame = texture(seed=3)
     tracker = IemdTracker()
     tracker.init(frame, (2.0, 100.0, 40.0, 40.0))
@@ -181,6 +248,7 @@ def test_a_target_lost_before_any_frame_learned_stays_lost_frame_after_frame():
 
 def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
     import iemd_ros.tracking.candidate as candidate
+
     solves = []
     solve = candidate.solve_emd
 
@@ -188,25 +256,35 @@ def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):
         solves.append(1)
         return dataclasses.replace(solve(*args, **kwargs), optimal=False)
 
-    monkeypatch.setattr(candidate, "solve_emd", non_optimal)
+    monkeypatch.setattr(candidate, 'solve_emd', non_optimal)
     frame = texture(seed=5)
-    tracker = IemdTracker(TrackerConfig(n_particles=4, particle_trigger=0.0))  # the particles run on every frame
+    # the particles run on every frame
+    tracker = IemdTracker(TrackerConfig(n_particles=4, particle_trigger=0.0))
     tracker.init(frame, (100.0, 80.0, 40.0, 40.0))
     solves.clear()
     result = tracker.update(shifted(frame, 3.0, 2.0))
-    assert result.starts == 3 + tracker.config.n_particles  # prediction, flow, translation filter, particles
+    # prediction, flow, translation filter, particles
+    assert result.starts == 3 + tracker.config.n_particles
     assert result.solver_warnings == len(solves) > 0
 
 
 def test_the_particles_catch_a_jump_of_half_a_window(car4_first):
-    """Section 6.1's particles (off by default, see TrackerConfig): Car4 moved by 0.45 window sizes, with
-    no flow start and no translation filter, is reached from the particle 0.5 window sizes to the right and
-    missed without them."""
+    """
+    Section 6.1's particles (off by default, see TrackerConfig).
+
+    Car4 moved by 0.45 window sizes, with no flow start and no translation filter, is reached from
+    the particle 0.5 window sizes to the right and missed without them.
+    """
     frame, box = car4_first
     jump = np.array([0.45 * box[2], 0.03 * box[3]])
     moved = shifted(frame, *jump)
-    config = TrackerConfig(scale_step=0, flow_start=False, translation_weight=0.0, particle_trigger=0.0,
-                           update_templates=False)
+    config = TrackerConfig(
+        scale_step=0,
+        flow_start=False,
+        translation_weight=0.0,
+        particle_trigger=0.0,
+        update_templates=False,
+    )
     boxes = {}
     for n_particles in (0, 4):
         tracker = IemdTracker(dataclasses.replace(config, n_particles=n_particles))
@@ -223,10 +301,14 @@ def test_visible_fraction_of_a_turned_window():
     # A 10 x 40 window whose centre is 10 px (pixel edges) from the left border:
     # upright it is all inside, turned by 90 degrees it reaches 10 px beyond the border.
     assert _visible_fraction((9.5, 99.5), (10.0, 40.0), 0.0, shape) == pytest.approx(1.0)
-    assert _visible_fraction((9.5, 99.5), (10.0, 40.0), np.pi / 2, shape) == pytest.approx(0.75, abs=1e-5)
+    assert _visible_fraction((9.5, 99.5), (10.0, 40.0), np.pi / 2, shape) == pytest.approx(
+        0.75, abs=1e-5
+    )
     # A square centred on the image corner keeps a quarter inside at any angle.
     for angle in (0.0, 0.3, np.pi / 4):
-        assert _visible_fraction((-0.5, -0.5), (20.0, 20.0), angle, shape) == pytest.approx(0.25, abs=1e-5)
+        assert _visible_fraction((-0.5, -0.5), (20.0, 20.0), angle, shape) == pytest.approx(
+            0.25, abs=1e-5
+        )
     assert _visible_fraction((400.0, 100.0), (20.0, 20.0), 0.3, shape) == 0.0
 
 
@@ -235,20 +317,30 @@ def test_reconstructed_template_removes_an_occluder():
     layout = PatchLayout((32, 32), (8, 8), 4)
     rng = np.random.default_rng(0)
     base = rng.uniform(0.2, 0.8, (32, 32))
-    d = TemplateDictionary(layout, n_templates=2, lam=0.01, forgetting=0.95, reconstruction_lambda=0.1)
+    d = TemplateDictionary(
+        layout, n_templates=2, lam=0.01, forgetting=0.95, reconstruction_lambda=0.1
+    )
     d.add(base, 0.0, 0)
     d.add(np.clip(base + 0.05 * rng.normal(size=base.shape), 0, 1), 0.0, 1)
     occluded = base.copy()
     occluded[8:20, 8:20] = 1.0
     recon = d.reconstruct(occluded)
-    assert np.abs(recon - base)[8:20, 8:20].mean() < 0.3 * np.abs(occluded - base)[8:20, 8:20].mean()
+    assert (
+        np.abs(recon - base)[8:20, 8:20].mean() < 0.3 * np.abs(occluded - base)[8:20, 8:20].mean()
+    )
 
 
 def test_template_update_rule():
-    """Algorithm 2: the latest template is replaced only when the current one outweighs its decayed weight."""
+    """
+    Algorithm 2's template update rule.
+
+    The latest template is replaced only when the current one outweighs its decayed weight.
+    """
     layout = PatchLayout((32, 32), (8, 8), 4)
     rng = np.random.default_rng(1)
-    d = TemplateDictionary(layout, n_templates=2, lam=0.01, forgetting=0.9, reconstruction_lambda=0.1)
+    d = TemplateDictionary(
+        layout, n_templates=2, lam=0.01, forgetting=0.9, reconstruction_lambda=0.1
+    )
     t0 = rng.uniform(0, 1, (32, 32))
     d.add(t0, 0.0, 0)
     assert d.observe(t0, 0.2, 1)  # fills the second slot
@@ -262,7 +354,7 @@ def test_template_update_rule():
 
 def test_tracks_a_real_otb_excerpt(otb_root):
     """Car4 frames 1-80 (illumination change under trees): average overlap > 0.7."""
-    seq = load_sequence(otb_root / "Car4")
+    seq = load_sequence(otb_root / 'Car4')
     tracker = IemdTracker()
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     boxes = [seq.gt_boxes[0]]
@@ -273,12 +365,16 @@ def test_tracks_a_real_otb_excerpt(otb_root):
 
 
 def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
-    """Jogging-1 frames 1-69.  At frame 69, as the post begins to hide the runner, the colour model's start lies
-    about a window height below her, on the road; without the motion prior it wins the score (measured: by 0.06)
-    and the tracker never comes back.  With the default motion_weight the window stays on her.  (Without the
-    occlusion check, update_confidence 0: with it the window stays on her without the prior too, measured 0.03
-    window heights off at frame 69.)"""
-    seq = load_sequence("Jogging-1", otb_root)
+    """
+    Jogging-1 frames 1-69.
+
+    At frame 69, as the post begins to hide the runner, the colour model's start lies about a
+    window height below her, on the road; without the motion prior it wins the score (measured: by
+    0.06) and the tracker never comes back.  With the default motion_weight the window stays on
+    her.  (Without the occlusion check, update_confidence 0: with it the window stays on her
+    without the prior too, measured 0.03 window heights off at frame 69.)
+    """
+    seq = load_sequence('Jogging-1', otb_root)
     frames = [read_frame(path) for path in seq.frame_paths[:70]]
     truth, height = box_centre(seq.gt_boxes[69]), seq.gt_boxes[69][3]
     offsets = {}
@@ -293,43 +389,72 @@ def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
 
 
 def test_a_post_hiding_the_runner_holds_or_loses_her_and_nothing_learns(otb_root):
-    """Jogging-2 frames 1-75.  Over frames 45-60 the runner passes behind a post.  Where the filter's response at
-    the window falls the frame is held (the window moves, keeps its size), where its peak falls further the frame is
-    lost (no box, the window keeps its place); on neither do the filters, the colour histograms or the template
-    learn, each checked against the models' state before the frame.  No frame outside the occlusion and the few frames
-    re-detection takes after it is held or lost, and she is tracked at frame 75."""
-    seq = load_sequence("Jogging-2", otb_root)
+    """
+    Jogging-2 frames 1-75.
+
+    Over frames 45-60 the runner passes behind a post.  Where the filter's response at the window
+    falls the frame is held (the window moves, keeps its size), where its peak falls further the
+    frame is lost (no box, the window keeps its place); on neither do the filters, the colour
+    histograms or the template learn, each checked against the models' state before the frame.  No
+    frame outside the occlusion and the few frames re-detection takes after it is held or lost, and
+    she is tracked at frame 75.
+    """
+    seq = load_sequence('Jogging-2', otb_root)
     frames = [read_frame(path) for path in seq.frame_paths[:76]]
     tracker = IemdTracker()
     tracker.init(frames[0], seq.gt_boxes[0])
     held, lost = [], []
     for k, frame in enumerate(frames[1:], start=1):
-        before = (tracker._size.copy(), tracker._translation_filter.f.copy(), tracker._scale_filter.template.copy(),
-                  tracker._colour_model._target.copy(), np.array(tracker.dictionary.templates))
+        before = (
+            tracker._size.copy(),
+            tracker._translation_filter.f.copy(),
+            tracker._scale_filter.template.copy(),
+            tracker._colour_model._target.copy(),
+            np.array(tracker.dictionary.templates),
+        )
         result = tracker.update(frame)
         if result.held or result.lost:
             (held if result.held else lost).append(k)
-            after = (tracker._size, tracker._translation_filter.f, tracker._scale_filter.template,
-                     tracker._colour_model._target, np.array(tracker.dictionary.templates))
+            after = (
+                tracker._size,
+                tracker._translation_filter.f,
+                tracker._scale_filter.template,
+                tracker._colour_model._target,
+                np.array(tracker.dictionary.templates),
+            )
             assert all(np.array_equal(a, b) for a, b in zip(before, after)), k
             assert result.scale == 1.0
-            assert ("models not updated" in result.reason) if result.held else (result.cause is not None)
-    assert len(held + lost) >= 5 and set(held + lost) <= set(range(44, 67)), (held, lost)  # re-found by 66
+            assert (
+                ('models not updated' in result.reason)
+                if result.held
+                else (result.cause is not None)
+            )
+    # re-found by 66
+    assert len(held + lost) >= 5 and set(held + lost) <= set(range(44, 67)), (held, lost)
     assert not result.lost and iou(result.box, seq.gt_boxes[75]).ravel()[0] > 0.5
 
 
 def test_search_prefers_a_window_the_occlusion_check_accepts(otb_root):
-    """Woman frames 1-150.  From about frame 115 a parked car hides her legs; at frame 125 the EMD pulls the
-    descent from the prediction 20 px down, where the translation filter's response is 0.02 (0.11 on her).
-    Scored by the EMD, filter and colour terms that window wins, every later frame is held, and by frame 140
-    the window is off her (measured: IoU 0).  Preferring a descended window the check accepts keeps it on her."""
-    seq = load_sequence(otb_root / "Woman")
+    """
+    Woman frames 1-150.
+
+    From about frame 115 a parked car hides her legs; at frame 125 the EMD pulls the descent from
+    the prediction 20 px down, where the translation filter's response is 0.02 (0.11 on her).
+    Scored by the EMD, filter and colour terms that window wins, every later frame is held, and by
+    frame 140 the window is off her (measured: IoU 0).  Preferring a descended window the check
+    accepts keeps it on her.
+    """
+    seq = load_sequence(otb_root / 'Woman')
     tracker = IemdTracker()
     tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
     results = [tracker.update(read_frame(path)) for path in seq.frame_paths[1:151]]
-    reported = [float(iou(r.box, seq.gt_boxes[k]).ravel()[0]) for k, r in enumerate(results, start=1)
-                if k >= 140 and not r.lost]
-    assert len(reported) >= 8 and min(reported) > 0.4, reported  # no box off her; lost while the car hides her
+    reported = [
+        float(iou(r.box, seq.gt_boxes[k]).ravel()[0])
+        for k, r in enumerate(results, start=1)
+        if k >= 140 and not r.lost
+    ]
+    # no box off her; lost while the car hides her
+    assert len(reported) >= 8 and min(reported) > 0.4, reported
 
 
 def test_scale_bounds_keep_the_window_between_a_few_pixels_and_the_image():
@@ -338,17 +463,26 @@ def test_scale_bounds_keep_the_window_between_a_few_pixels_and_the_image():
     def _bounded_scale(scale, size, shape):
         return float(np.clip(scale, *_scale_bounds(size, shape)))
 
-    assert _bounded_scale(1.05, (100.0, 80.0), shape) == 1.05                      # inside: untouched
-    assert _bounded_scale(0.5, (6.0, 40.0), shape) == MIN_SIDE_PX / 6.0            # shorter side kept at 4 px
-    assert np.isclose(_bounded_scale(2.0, (300.0, 200.0), shape) ** 2 * 300 * 200, 240 * 360)  # area <= image
-    assert _bounded_scale(1.1, (400.0, 300.0), shape) == 1.0                       # already larger: no further
-    assert _bounded_scale(0.9, (400.0, 300.0), shape) == 0.9                       # ... but it may shrink
+    # inside: untouched
+    assert _bounded_scale(1.05, (100.0, 80.0), shape) == 1.05
+    # shorter side kept at 4 px
+    assert _bounded_scale(0.5, (6.0, 40.0), shape) == MIN_SIDE_PX / 6.0
+    # area <= image
+    assert np.isclose(_bounded_scale(2.0, (300.0, 200.0), shape) ** 2 * 300 * 200, 240 * 360)
+    # already larger: no further
+    assert _bounded_scale(1.1, (400.0, 300.0), shape) == 1.0
+    # ... but it may shrink
+    assert _bounded_scale(0.9, (400.0, 300.0), shape) == 0.9
 
 
 def test_a_window_started_too_large_never_outgrows_the_image(otb_root):
-    """Car4 from its first box scaled by 1.2 about the centre: the scale filter learns the road in the window as
-    target and the window grows; without the bound its area exceeded the image's by frame 195 (measured)."""
-    seq = load_sequence(otb_root / "Car4")
+    """
+    Car4 from its first box scaled by 1.2 about the centre.
+
+    The scale filter learns the road in the window as target and the window grows; without the
+    bound its area exceeded the image's by frame 195 (measured).
+    """
+    seq = load_sequence(otb_root / 'Car4')
     x, y, w, h = seq.gt_boxes[0]
     frames = [read_frame(path) for path in seq.frame_paths[:230]]
     height, width = frames[0].shape[:2]
@@ -358,25 +492,34 @@ def test_a_window_started_too_large_never_outgrows_the_image(otb_root):
     for frame in frames[1:]:
         box = tracker.update(frame).box
         areas.append(box[2] * box[3])
-    assert max(areas) > 0.9 * width * height      # it does grow to the bound
+    assert max(areas) > 0.9 * width * height  # it does grow to the bound
     assert max(areas) <= width * height * (1 + 1e-9)
 
 
 def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
-    """building5 (UAV123@10fps, 1280x720), frames 1-100 from the ground truth: a walking person of about 22x62 px
-    seen from a drone that moves.  Bound: mean IoU at least 0.75 and no frame below 0.5 (measured: 0.84, lowest
-    0.66)."""
-    seq = load_sequence(uav_root / "building5")
+    """
+    building5 (UAV123@10fps, 1280x720), frames 1-100 from the ground truth.
+
+    A walking person of about 22x62 px seen from a drone that moves.  Bound: mean IoU at least 0.75
+    and no frame below 0.5 (measured: 0.84, lowest 0.66).
+    """
+    seq = load_sequence(uav_root / 'building5')
     frames = [read_frame(path) for path in seq.frame_paths[:100]]
     tracker = IemdTracker()
     tracker.init(frames[0], seq.gt_boxes[0])
-    overlaps = [float(iou(tracker.update(frame).box, seq.gt_boxes[k]).ravel()[0])
-                for k, frame in enumerate(frames[1:], start=1)]
+    overlaps = [
+        float(iou(tracker.update(frame).box, seq.gt_boxes[k]).ravel()[0])
+        for k, frame in enumerate(frames[1:], start=1)
+    ]
     assert np.mean(overlaps) >= 0.75 and min(overlaps) >= 0.5, (np.mean(overlaps), min(overlaps))
 
 
 class _Inline:
-    """An executor that runs each job at once on the calling thread: the tracker's serial schedule."""
+    """
+    An executor that runs each job at once on the calling thread.
+
+    It gives the tracker's serial schedule.
+    """
 
     def submit(self, fn, *args):
         future = Future()
@@ -385,7 +528,7 @@ class _Inline:
 
 
 def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, monkeypatch):
-    seq = load_sequence(otb_root / "Woman")
+    seq = load_sequence(otb_root / 'Woman')
     frames = [read_frame(p) for p in seq.frame_paths[:25]]
 
     def run():
@@ -394,7 +537,7 @@ def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, mon
         return [tracker.update(frame) for frame in frames[1:]]
 
     threaded = run()
-    monkeypatch.setattr(tracker_module, "_workers", lambda: _Inline())
+    monkeypatch.setattr(tracker_module, '_workers', lambda: _Inline())
     serial = run()
     assert [r.box for r in threaded] == [r.box for r in serial]
     assert [r.emd for r in threaded] == [r.emd for r in serial]

@@ -1,57 +1,113 @@
-"""The translation filter (STRCF, iemd_ros/tracking/translation_filter.py) and the tracker's use of its response."""
-import numpy as np
-import pytest
-from helpers import shifted
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
+"""
+The translation filter (STRCF) and the tracker's use of its response.
+
+The filter is iemd_ros/tracking/translation_filter.py.
+"""
+from helpers import shifted
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking import features
 from iemd_ros.tracking.translation_filter import TranslationFilter
+import numpy as np
+import pytest
 
 
 def _learned(frame, box, angle=0.0):
     translation_filter = TranslationFilter()
-    translation_filter.init(frame, box_centre(box), box[2:], colour=frame.ndim == 3 and frame[..., 0].std() > 0,
-                            angle=angle)
+    translation_filter.init(
+        frame,
+        box_centre(box),
+        box[2:],
+        colour=frame.ndim == 3 and frame[..., 0].std() > 0,
+        angle=angle,
+    )
     return translation_filter
 
 
-@pytest.mark.parametrize("angle", [0.0, np.pi / 2, 0.6])
+@pytest.mark.parametrize('angle', [0.0, np.pi / 2, 0.6])
 def test_recovers_a_known_shift_of_a_real_texture(car4_first, angle):
-    """Car4's frame moved by known shifts, up to 2.5 cells: the filter learned on the target (in a region turned by
-    ``angle``) finds the move in image pixels to within a quarter of a cell (12 image px here: the 483 px region
-    resampled to 160 px) by the refinement of its peak."""
+    """
+    Car4's frame moved by known shifts, up to 2.5 cells.
+
+    The filter learned on the target (in a region turned by ``angle``) finds the move in image
+    pixels to within a quarter of a cell (12 image px here: the 483 px region resampled to 160 px)
+    by the refinement of its peak.
+    """
     frame, box = car4_first
     centre, size = box_centre(box), box[2:]
     tf = _learned(frame, box, angle)
     cell_px = features.CELL * tf._scale(size)
-    assert np.linalg.norm(tf.estimate(frame, centre, size, angle) - (np.round(centre) - centre if angle == 0 else 0)) \
+    assert (
+        np.linalg.norm(
+            tf.estimate(frame, centre, size, angle)
+            - (np.round(centre) - centre if angle == 0 else 0)
+        )
         < 0.1 * cell_px
+    )
     for move in [(5.0, 3.0), (-8.0, 2.0), (0.0, -10.0), (-20.0, 14.0)]:
         estimate = tf.estimate(shifted(frame, *move), centre, size, angle)
         assert np.linalg.norm(estimate - move) < cell_px / 4, (move, estimate, cell_px)
-    assert tf.confidence["peak"] > 0 and tf.confidence["apce"] > 1
+    assert tf.confidence['peak'] > 0 and tf.confidence['apce'] > 1
 
 
 def test_response_at_reads_the_map_between_cells(car4_first):
-    """At the region's centre response_at is the map's cell (0, 0); half a cell to the right the mean of cells
-    (0, 0) and (0, 1); the map is circular over the search region."""
+    """
+    At the region's centre response_at is the map's cell (0, 0).
+
+    Half a cell to the right the mean of cells (0, 0) and (0, 1); the map is circular over the
+    search region.
+    """
     frame, box = car4_first
     centre, size = box_centre(box), box[2:]
     tf = _learned(frame, box)
-    with pytest.raises(RuntimeError, match="needs an estimate"):
+    with pytest.raises(RuntimeError, match='needs an estimate'):
         TranslationFilter().response_at(centre)
     tf.estimate(shifted(frame, 3.0, 2.0), centre, size)
     response, pos, cell_px, _ = tf._response
     assert tf.response_at(pos) == pytest.approx(response[0, 0])
-    assert tf.response_at(pos + [cell_px / 2.0, 0.0]) == pytest.approx((response[0, 0] + response[0, 1]) / 2.0)
+    assert tf.response_at(pos + [cell_px / 2.0, 0.0]) == pytest.approx(
+        (response[0, 0] + response[0, 1]) / 2.0
+    )
     n = tf.map_hw[0]
     assert tf.response_at(pos + [n * cell_px, 0.0]) == pytest.approx(response[0, 0])
 
 
 def test_update_learns_the_tracked_window(car4_first):
-    """Learned again on a frame moved by (6, 4) at the window it found there, the filter finds (almost) no move
-    from the new centre: the temporal term keeps a share of the old filter."""
+    """
+    Learned again on a frame moved by (6, 4) at the window it found there.
+
+    The filter finds (almost) no move from the new centre: the temporal term keeps a share of the
+    old filter.
+    """
     frame, box = car4_first
     centre, size = box_centre(box), box[2:]
     tf = _learned(frame, box)
@@ -59,12 +115,19 @@ def test_update_learns_the_tracked_window(car4_first):
     new_centre = centre + tf.estimate(moved, centre, size)
     assert np.linalg.norm(new_centre - centre - (6.0, 4.0)) < 1.5
     tf.update(moved, new_centre, size)
-    assert np.linalg.norm(tf.estimate(moved, new_centre, size) - (np.round(new_centre) - new_centre)) < 1.0
+    assert (
+        np.linalg.norm(tf.estimate(moved, new_centre, size) - (np.round(new_centre) - new_centre))
+        < 1.0
+    )
 
 
 def test_the_tracker_adds_the_filter_start_and_follows_a_shift(car4_first):
-    """Car4's frame moved by (9, -6): with the filter the tracker searches from one more start and ends on the
-    moved target; translation_weight 0 builds no filter (two starts: the prediction and the flow)."""
+    """
+    Car4's frame moved by (9, -6).
+
+    With the filter the tracker searches from one more start and ends on the moved target;
+    translation_weight 0 builds no filter (two starts: the prediction and the flow).
+    """
     frame, box = car4_first
     moved = shifted(frame, 9.0, -6.0)
     for weight, starts in [(1.0, 3), (0.0, 2)]:
@@ -76,9 +139,14 @@ def test_the_tracker_adds_the_filter_start_and_follows_a_shift(car4_first):
 
 
 def test_the_score_weighs_the_filter_response_against_the_emd(car4_first, monkeypatch):
-    """The search keeps the descended window of lowest EMD / background EMD - translation_weight x response.  A
-    stand-in filter points at a decoy 30 px right of the target's true move (9, -6) and responds only there: with a
-    negligible weight the EMD's window on the target is kept, with weight 1 the decoy's."""
+    """
+    The search's score weighs the filter's response against the EMD.
+
+    The search keeps the descended window of lowest EMD / background EMD - translation_weight x
+    response.  A stand-in filter points at a decoy 30 px right of the target's true move (9, -6)
+    and responds only there: with a negligible weight the EMD's window on the target is kept, with
+    weight 1 the decoy's.
+    """
     frame, box = car4_first
     moved = shifted(frame, 9.0, -6.0)
     decoy = box_centre(box) + [39.0, -6.0]
@@ -86,9 +154,14 @@ def test_the_score_weighs_the_filter_response_against_the_emd(car4_first, monkey
     for weight in (1e-6, 1.0):
         tracker = IemdTracker(TrackerConfig(translation_weight=weight, update_templates=False))
         tracker.init(frame, box)
-        monkeypatch.setattr(tracker._translation_filter, "estimate", lambda frame, centre, *_: decoy - centre)
-        monkeypatch.setattr(tracker._translation_filter, "response_at",
-                            lambda point: float(np.exp(-np.sum((np.asarray(point) - decoy) ** 2) / 50.0)))
+        monkeypatch.setattr(
+            tracker._translation_filter, 'estimate', lambda frame, centre, *_: decoy - centre
+        )
+        monkeypatch.setattr(
+            tracker._translation_filter,
+            'response_at',
+            lambda point: float(np.exp(-np.sum((np.asarray(point) - decoy) ** 2) / 50.0)),
+        )
         results[weight] = tracker.update(moved)
     on_target = np.asarray(box[:2]) + [9.0, -6.0]
     assert np.allclose(results[1e-6].box[:2], on_target, atol=1.5), results[1e-6].box
@@ -96,11 +169,15 @@ def test_the_score_weighs_the_filter_response_against_the_emd(car4_first, monkey
 
 
 def test_search_frame_finds_the_target_moved_anywhere_in_a_drone_frame(uav_root):
-    """building5's first 1280x720 frame with the person moved by up to 400 px: the whole-frame search, its strips
-    taken in turn, puts the strongest response within one cell of her (a cell is 4 px of the resampled frame), and
-    its strips cover the frame once."""
+    """
+    building5's first 1280x720 frame with the person moved by up to 400 px.
+
+    The whole-frame search, its strips taken in turn, puts the strongest response within one cell
+    of her (a cell is 4 px of the resampled frame), and its strips cover the frame once.
+    """
     from iemd_ros.datasets.otb import load_sequence, read_frame
-    seq = load_sequence(uav_root / "building5")
+
+    seq = load_sequence(uav_root / 'building5')
     frame, box = read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0], float)
     tf = _learned(frame, box)
     cell_px = features.CELL * tf._scale(box[2:])
@@ -108,5 +185,7 @@ def test_search_frame_finds_the_target_moved_anywhere_in_a_drone_frame(uav_root)
         moved = shifted(frame, *move)
         parts = tf.search_frame(moved, box[2:], 0)[2]
         assert parts > 1  # a 1280x720 frame is searched over several lost frames
-        found = max((tf.search_frame(moved, box[2:], part) for part in range(parts)), key=lambda r: r[1])[0]
+        found = max(
+            (tf.search_frame(moved, box[2:], part) for part in range(parts)), key=lambda r: r[1]
+        )[0]
         assert np.linalg.norm(found - (box_centre(box) + move)) < 1.5 * cell_px, (move, found)

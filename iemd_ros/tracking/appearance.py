@@ -1,13 +1,42 @@
-"""Appearance sampling: target window -> fixed-size template -> local patches (section 4).
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
-Geometry conventions (0-based image pixels, pixel centres at integer
-coordinates): a window is its centre ``(cx, cy)`` and size ``(w, h)``.
-Template pixel ``u`` (0..T-1) samples image point
-``cx + (u - (T-1)/2) * w/T`` along the window's x axis, which a window turned by
-``angle`` points along (cos, sin) (:meth:`ImagePyramid.sample`).  Patch positions ``c`` are the patch centres
-relative to the window centre in *normalized window units*: the window spans
-[-1, 1] on each axis, so positions, the spatial kernel and the spatial term of
-the ground distance do not depend on the target's size in pixels.
+"""
+Appearance sampling: target window -> fixed-size template -> local patches (section 4).
+
+Geometry conventions (0-based image pixels, pixel centres at integer coordinates): a window is its
+centre ``(cx, cy)`` and size ``(w, h)``.  Template pixel ``u`` (0..T-1) samples image point
+``cx + (u - (T-1)/2) * w/T`` along the window's x axis, which a window turned by ``angle`` points
+along (cos, sin) (:meth:`ImagePyramid.sample`).  Patch positions ``c`` are the patch centres
+relative to the window centre in *normalized window units*: the window spans [-1, 1] on each axis,
+so positions, the spatial kernel and the spatial term of the ground distance do not depend on the
+target's size in pixels.
 """
 from __future__ import annotations
 
@@ -20,9 +49,11 @@ import numpy as np
 
 
 def to_gray(frame: np.ndarray) -> np.ndarray:
-    """Grey levels in [0, 1] of a uint8 frame.
+    """
+    Grey levels in [0, 1] of a uint8 frame.
 
-    The paper's "normalized pixel values" are grey levels (docs/decisions.md#grey-patches-template-size).
+    The paper's "normalized pixel values" are grey levels
+    (docs/decisions.md#grey-patches-template-size).
 
     Parameters
     ----------
@@ -33,24 +64,28 @@ def to_gray(frame: np.ndarray) -> np.ndarray:
     -------
     ndarray
         HxW float32 grey levels in [0, 1].
+
     """
     return np.multiply(grey_levels(frame), np.float32(1.0 / 255.0), dtype=np.float32)
 
 
 def grey_levels(frame: np.ndarray, copy: bool = False) -> np.ndarray:
-    """HxW uint8 grey levels of a uint8 frame.
+    """
+    Return the HxW uint8 grey levels of a uint8 frame.
 
     Parameters
     ----------
     frame : ndarray
         HxW or HxWx3 (BGR) uint8 frame.
     copy : bool, optional
-        Copy a grey frame rather than return it: for a result to keep, which must not share the caller's buffer.
+        Copy a grey frame rather than return it: for a result to keep, which must not share the
+        caller's buffer.
 
     Returns
     -------
     ndarray
         HxW uint8 grey levels: the frame itself if it is grey, unless ``copy``.
+
     """
     if frame.ndim == 3:
         return cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
@@ -58,7 +93,8 @@ def grey_levels(frame: np.ndarray, copy: bool = False) -> np.ndarray:
 
 
 def window_axes(angle: float) -> np.ndarray:
-    """Rotation taking the axes of a window turned by ``angle`` to image axes.
+    """
+    Rotation taking the axes of a window turned by ``angle`` to image axes.
 
     Parameters
     ----------
@@ -69,13 +105,17 @@ def window_axes(angle: float) -> np.ndarray:
     -------
     ndarray
         2x2 rotation whose columns are the window's x and y axes in the image.
+
     """
     c, s = np.cos(angle), np.sin(angle)
     return np.array([[c, -s], [s, c]])
 
 
-def warp_window(image: np.ndarray, centre, linear: np.ndarray, out_size, interpolation: int = cv2.INTER_LINEAR):
-    """Sample ``image`` on a grid of ``out_size`` pixels mapped affinely around ``centre``.
+def warp_window(
+    image: np.ndarray, centre, linear: np.ndarray, out_size, interpolation: int = cv2.INTER_LINEAR
+):
+    """
+    Sample ``image`` on a grid of ``out_size`` pixels mapped affinely around ``centre``.
 
     Parameters
     ----------
@@ -93,29 +133,39 @@ def warp_window(image: np.ndarray, centre, linear: np.ndarray, out_size, interpo
     Returns
     -------
     ndarray
-        The (Th, Tw) sample whose pixel u (0..T-1 per axis) is the image point ``centre + linear @ (u - (T-1)/2)``;
-        parts outside the image replicate its border.
+        The (Th, Tw) sample whose pixel u (0..T-1 per axis) is the image point
+        ``centre + linear @ (u - (T-1)/2)``; parts outside the image replicate its border.
+
     """
     tw, th = (int(v) for v in out_size)
-    warp = np.column_stack([linear, np.asarray(centre, dtype=np.float64) - linear @ [(tw - 1) / 2, (th - 1) / 2]])
-    return cv2.warpAffine(image, warp, (tw, th), flags=interpolation | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REPLICATE)
+    warp = np.column_stack(
+        [linear, np.asarray(centre, dtype=np.float64) - linear @ [(tw - 1) / 2, (th - 1) / 2]]
+    )
+    return cv2.warpAffine(
+        image,
+        warp,
+        (tw, th),
+        flags=interpolation | cv2.WARP_INVERSE_MAP,
+        borderMode=cv2.BORDER_REPLICATE,
+    )
 
 
 class ImagePyramid:
-    """Gaussian pyramid of one frame, so large windows are sampled without aliasing.
+    """
+    Gaussian pyramid of one frame, so large windows are sampled without aliasing.
 
-    A window whose template scale (image pixels per template pixel) is s is sampled bilinearly from level
-    ``floor(log2(s))``, where its scale is in [1, 2): every template pixel then integrates at least one
-    pyrDown-smoothed pixel.  The levels are built on demand (:meth:`level`).
+    A window whose template scale (image pixels per template pixel) is s is sampled bilinearly from
+    level ``floor(log2(s))``, where its scale is in [1, 2): every template pixel then integrates at
+    least one pyrDown-smoothed pixel.  The levels are built on demand (:meth:`level`).
 
     Parameters
     ----------
     gray : ndarray
         The frame's grey levels (level 0).
     max_levels : int, optional
-        Most levels above the frame; a level is added only while the one below it has both sides of at least 32
-        pixels.
+        Most levels above the frame; a level is added only while the one below it has both sides of
+        at least 32 pixels.
+
     """
 
     def __init__(self, gray: np.ndarray, max_levels: int = 4):
@@ -127,7 +177,8 @@ class ImagePyramid:
             self.n_levels += 1
 
     def level(self, index: int) -> np.ndarray:
-        """Pyramid level ``index``, computed with the ones below it on first use.
+        """
+        Pyramid level ``index``, computed with the ones below it on first use.
 
         Parameters
         ----------
@@ -138,13 +189,15 @@ class ImagePyramid:
         -------
         ndarray
             The level's image.
+
         """
         while len(self._levels) <= index:
             self._levels.append(cv2.pyrDown(self._levels[-1]))
         return self._levels[index]
 
     def sample(self, center, size, template_size, angle: float = 0.0) -> np.ndarray:
-        """Resample a window to a template.
+        """
+        Resample a window to a template.
 
         Parameters
         ----------
@@ -155,21 +208,26 @@ class ImagePyramid:
         template_size : tuple of int
             (Tw, Th).
         angle : float, optional
-            Rotation of the window about its centre, radians: its x axis points along (cos, sin) in the image.
+            Rotation of the window about its centre, radians: its x axis points along (cos, sin) in
+            the image.
 
         Returns
         -------
         ndarray
             The (Th, Tw) template; parts outside the image are padded by replicating the border.
+
         """
         level, linear, centre = self._geometry(center, size, template_size, angle)
         return warp_window(self.level(level), centre, linear, template_size)
 
-    def sample_scales(self, center, size, template_size, factors, angle: float = 0.0) -> np.ndarray:
-        """The window scaled by each of ``factors`` about its centre, resampled to templates.
+    def sample_scales(
+        self, center, size, template_size, factors, angle: float = 0.0
+    ) -> np.ndarray:
+        """
+        Return the window scaled by each of ``factors`` about its centre, resampled to templates.
 
-        One remap from the anti-aliasing level of the unscaled window: the same smoothing at every scale, so the
-        templates differ by their scale only.
+        One remap from the anti-aliasing level of the unscaled window: the same smoothing at every
+        scale, so the templates differ by their scale only.
 
         Parameters
         ----------
@@ -186,19 +244,28 @@ class ImagePyramid:
         -------
         ndarray
             (len(factors), Th, Tw) templates.
+
         """
         tw, th = template_size
         level, linear, centre = self._geometry(center, size, template_size, angle)
-        grid = np.stack(np.meshgrid(np.arange(tw) - (tw - 1) / 2, np.arange(th) - (th - 1) / 2))  # (2, Th, Tw)
-        offsets = np.einsum("ij,jhw->ihw", linear, grid)  # image offset of each template pixel at scale 1
+        # (2, Th, Tw)
+        grid = np.stack(np.meshgrid(np.arange(tw) - (tw - 1) / 2, np.arange(th) - (th - 1) / 2))
+        # image offset of each template pixel at scale 1
+        offsets = np.einsum('ij,jhw->ihw', linear, grid)
         factors = np.asarray(factors, dtype=np.float64)
         maps = centre[:, None, None, None] + factors[None, :, None, None] * offsets[:, None]
         maps = maps.reshape(2, -1, int(tw)).astype(np.float32)
-        out = cv2.remap(self.level(level), maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        out = cv2.remap(
+            self.level(level), maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+        )
         return out.reshape(len(factors), int(th), int(tw))
 
     def _geometry(self, center, size, template_size, angle: float):
-        """(pyramid level, linear map of template pixels to that level's pixels, window centre there)."""
+        """
+        Return where a window is sampled: (pyramid level, linear map, window centre there).
+
+        The linear map takes template pixels to that level's pixels.
+        """
         tw, th = template_size
         sx, sy = size[0] / tw, size[1] / th
         level = int(np.floor(np.log2(max(min(sx, sy), 1.0))))
@@ -212,7 +279,8 @@ class ImagePyramid:
 
 @dataclass(frozen=True)
 class PatchLayout:
-    """Local patches m x n with step s over a template (paper: 8x8 step 4 on 32x32).
+    """
+    Local patches m x n with step s over a template (paper: 8x8 step 4 on 32x32).
 
     Parameters
     ----------
@@ -223,39 +291,48 @@ class PatchLayout:
     step : int
         Stride between patches, template pixels.
     min_contrast : float, optional
-        Grey-level standard deviation below which a patch counts as flat (docs/decisions.md#patch-normalization).
+        Grey-level standard deviation below which a patch counts as flat
+        (docs/decisions.md#patch-normalization).
 
     Raises
     ------
     ValueError
         When the patches do not fit the template or the step is below 1.
+
     """
 
     template_size: tuple[int, int]  # (Tw, Th)
     patch_size: tuple[int, int]  # (m, n) = (width, height)
     step: int
-    min_contrast: float = 0.02  # grey-level std below which a patch counts as flat (docs/decisions.md#patch-normalization)
+    # grey-level std below which a patch counts as flat (docs/decisions.md#patch-normalization)
+    min_contrast: float = 0.02
 
     def __post_init__(self):
         tw, th = self.template_size
         pw, ph = self.patch_size
         if pw > tw or ph > th or self.step < 1:
-            raise ValueError(f"patches {self.patch_size} step {self.step} do not fit a template {self.template_size}")
+            raise ValueError(
+                f'patches {self.patch_size} step {self.step} do not fit a template '
+                f'{self.template_size}'
+            )
 
     @property
     def cells(self) -> tuple[int, int]:
-        """Number of patches per row and column of the template."""
+        """Return the number of patches per row and column of the template."""
         tw, th = self.template_size
         pw, ph = self.patch_size
         return (tw - pw) // self.step + 1, (th - ph) // self.step + 1
 
     def positions(self) -> np.ndarray:
-        """Normalized centres of the window's patches.
+        """
+        Return the normalized centres of the window's patches.
 
         Returns
         -------
         ndarray
-            (N, 2) centres, row-major like :meth:`extract`; read-only: one array shared by every model of the layout.
+            (N, 2) centres, row-major like :meth:`extract`; read-only: one array shared by every
+            model of the layout.
+
         """
         return self._positions
 
@@ -272,11 +349,13 @@ class PatchLayout:
         return positions
 
     def extract(self, template: np.ndarray) -> np.ndarray:
-        """Appearance vectors epsilon of a template's patches, the paper's "normalized pixel values" (section 4).
+        """
+        Appearance vectors epsilon of a template's patches (section 4).
 
-        Each patch is brought to zero mean and unit norm, invariant to local brightness and contrast; a patch whose
-        standard deviation is below ``min_contrast`` is scaled as if it had that contrast (a shorter vector), so flat
-        patches do not amplify noise (docs/decisions.md#patch-normalization).
+        They are the paper's "normalized pixel values": each patch is brought to zero mean and unit
+        norm, invariant to local brightness and contrast; a patch whose standard deviation is below
+        ``min_contrast`` is scaled as if it had that contrast (a shorter vector), so flat patches
+        do not amplify noise (docs/decisions.md#patch-normalization).
 
         Parameters
         ----------
@@ -292,14 +371,16 @@ class PatchLayout:
         ------
         ValueError
             When the template's shape is not the layout's.
+
         """
         return self.extract_with_jacobian(template, jacobian=False)[0]
 
     def extract_with_jacobian(self, template: np.ndarray, jacobian: bool = True):
-        """Appearance vectors epsilon and their derivative with respect to moving the window.
+        """
+        Appearance vectors epsilon and their derivative with respect to moving the window.
 
-        The derivative is per template pixel of window motion (x, y): the patch pixels' grey-level gradients (central
-        differences of the template) pushed through the normalization.
+        The derivative is per template pixel of window motion (x, y): the patch pixels' grey-level
+        gradients (central differences of the template) pushed through the normalization.
 
         Parameters
         ----------
@@ -319,14 +400,19 @@ class PatchLayout:
         ------
         ValueError
             When the template's shape is not the layout's.
+
         """
         template = np.asarray(template, dtype=np.float64)
         if template.shape != self.template_size[::-1]:
-            raise ValueError(f"template of shape {template.shape} does not match {self.template_size[::-1]}")
+            raise ValueError(
+                f'template of shape {template.shape} does not match {self.template_size[::-1]}'
+            )
         pw, ph = self.patch_size
         floor = self.min_contrast * np.sqrt(pw * ph)
         gx, gy = _gradient(template) if jacobian else (template, template)
-        eps, jac = _unit_patches(template.ravel(), gx.ravel(), gy.ravel(), self._patch_index, floor, jacobian)
+        eps, jac = _unit_patches(
+            template.ravel(), gx.ravel(), gy.ravel(), self._patch_index, floor, jacobian
+        )
         return eps, (jac if jacobian else None)
 
     @cached_property
@@ -335,7 +421,9 @@ class PatchLayout:
         tw = self.template_size[0]
         pw, ph = self.patch_size
         nx, ny = self.cells
-        corners = (np.arange(ny)[:, None] * self.step * tw + np.arange(nx)[None, :] * self.step).ravel()
+        corners = (
+            np.arange(ny)[:, None] * self.step * tw + np.arange(nx)[None, :] * self.step
+        ).ravel()
         offsets = (np.arange(ph)[:, None] * tw + np.arange(pw)[None, :]).ravel()
         return corners[:, None] + offsets[None, :]
 
@@ -353,10 +441,11 @@ def _patch_mean(flat, pixels):
 
 @numba.njit(cache=True)
 def _unit_patches(flat, gx, gy, index, floor, jacobian):
-    """Patches of a flat template brought to zero mean and unit norm, and their Jacobian.
+    """
+    Patches of a flat template brought to zero mean and unit norm, and their Jacobian.
 
-    eps = p / max(||p||, floor); above the floor d eps = (I - eps eps') dp / ||p||, below it dp / floor, with dp
-    the zero-mean patch of the grey-level gradients; one pass per patch.
+    eps = p / max(||p||, floor); above the floor d eps = (I - eps eps') dp / ||p||, below it dp /
+    floor, with dp the zero-mean patch of the grey-level gradients; one pass per patch.
     """
     n, d = index.shape
     eps = np.empty((n, d))
@@ -391,7 +480,11 @@ def _unit_patches(flat, gx, gy, index, floor, jacobian):
 
 @numba.njit(cache=True)
 def _gradient(image):
-    """(d/dx, d/dy) of a 2-D image as ``np.gradient``: central differences, one-sided at the borders."""
+    """
+    (d/dx, d/dy) of a 2-D image as ``np.gradient``.
+
+    Central differences, one-sided at the borders.
+    """
     h, w = image.shape
     gx = np.empty((h, w))
     gy = np.empty((h, w))

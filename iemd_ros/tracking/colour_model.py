@@ -1,36 +1,68 @@
-"""Colour evidence of the window's position: foreground and background colour histograms (Staple).
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
-The iEMD patches and the correlation filters see grey levels only, and a target often differs from its
-surroundings more in colour than in texture.  Staple (Bertinetto et al., "Staple: Complementary Learners for
-Real-Time Tracking", CVPR 2016, eqs. 20-22) scores a window by the share of its pixels whose colour is more frequent
-on the target than around it: per colour bin b, with rho_O(b) and rho_B(b) the fractions of the target's and of the
-surrounding pixels in b, a pixel of bin b scores beta(b) = rho_O / (rho_O + rho_B) (0 where neither has it; a table
-kept with the histograms) and a window the mean of beta over its pixels, for every window position at once from an
-integral image.
+"""
+Colour evidence of the window's position: foreground and background colour histograms (Staple).
 
-The search region, the window's size plus ``padding`` times sqrt(w h) on every side (and the window itself once
-more, so every window centred up to that far is inside it), is resampled in the window's axes to at most
-``model_area`` pixels (nearest neighbour: colours are not blended), so the cost does not grow with the target and a
-window turned by the gyro prior is handled like any other.  The histograms count RGB in ``bins`` levels per channel
-over the window (the target) and over the window grown by half its mean side less the window (the surroundings,
-Staple's areas), as running averages at ``learning_rate``; parts outside the image replicate its border.  The
-tracker takes the position of highest mean as one more start and the mean at each window as evidence in its score,
-on colour frames only (docs/decisions.md#colour-model).
+The iEMD patches and the correlation filters see grey levels only, and a target often differs from
+its surroundings more in colour than in texture.  Staple (Bertinetto et al., "Staple: Complementary
+Learners for Real-Time Tracking", CVPR 2016, eqs. 20-22) scores a window by the share of its pixels
+whose colour is more frequent on the target than around it: per colour bin b, with rho_O(b) and
+rho_B(b) the fractions of the target's and of the surrounding pixels in b, a pixel of bin b scores
+beta(b) = rho_O / (rho_O + rho_B) (0 where neither has it; a table kept with the histograms) and a
+window the mean of beta over its pixels, for every window position at once from an integral image.
+
+The search region, the window's size plus ``padding`` times sqrt(w h) on every side (and the window
+itself once more, so every window centred up to that far is inside it), is resampled in the
+window's axes to at most ``model_area`` pixels (nearest neighbour: colours are not blended), so the
+cost does not grow with the target and a window turned by the gyro prior is handled like any other.
+The histograms count RGB in ``bins`` levels per channel over the window (the target) and over the
+window grown by half its mean side less the window (the surroundings, Staple's areas), as running
+averages at ``learning_rate``; parts outside the image replicate its border.  The tracker takes the
+position of highest mean as one more start and the mean at each window as evidence in its score, on
+colour frames only (docs/decisions.md#colour-model).
 """
 from __future__ import annotations
 
 import cv2
-import numpy as np
-
 from iemd_ros.tracking.appearance import warp_window, window_axes
+import numpy as np
 
 
 class ColourModel:
-    """Staple's colour model of the target against its surroundings (see the module docstring).
+    """
+    Staple's colour model of the target against its surroundings (see the module docstring).
 
-    ``init`` at the target's window, per frame ``estimate`` around the predicted window (then ``score_at`` for
-    candidate centres) and, when the frame is tracked, ``update`` at the tracked window.  Frames are HxWx3 uint8 (BGR);
-    windows are (centre, size (w, h), angle) as in :meth:`iemd_ros.tracking.appearance.ImagePyramid.sample`.
+    ``init`` at the target's window, per frame ``estimate`` around the predicted window (then
+    ``score_at`` for candidate centres) and, when the frame is tracked, ``update`` at the tracked
+    window.  Frames are HxWx3 uint8 (BGR); windows are (centre, size (w, h), angle) as in
+    :meth:`iemd_ros.tracking.appearance.ImagePyramid.sample`.
 
     Parameters
     ----------
@@ -46,17 +78,19 @@ class ColourModel:
     Raises
     ------
     ValueError
-        For a negative ``padding``, a ``learning_rate`` outside (0, 1] or ``bins`` not a power of 2 up to 64.
+        For a negative ``padding``, a ``learning_rate`` outside (0, 1] or ``bins`` not a power of 2
+        up to 64.
+
     """
 
     def __init__(self, padding: float = 1.0, learning_rate: float = 0.04, bins: int = 32,
                  model_area: int = 16384):
         if padding < 0:
-            raise ValueError(f"padding must be >= 0, got {padding}")
+            raise ValueError(f'padding must be >= 0, got {padding}')
         if not 0.0 < learning_rate <= 1.0:
-            raise ValueError(f"learning_rate must be in (0, 1], got {learning_rate}")
+            raise ValueError(f'learning_rate must be in (0, 1], got {learning_rate}')
         if bins not in (2, 4, 8, 16, 32, 64):  # bins**3 histogram entries: 64 -> 262144
-            raise ValueError(f"bins must be a power of 2 up to 64, got {bins}")
+            raise ValueError(f'bins must be a power of 2 up to 64, got {bins}')
         self.padding = padding
         self.learning_rate = learning_rate
         self.bins = bins
@@ -64,7 +98,8 @@ class ColourModel:
         self._shift = 8 - int(np.log2(bins))
         self._beta = None  # beta per colour bin, (bins**3,): from rho_O and rho_B
         self._target = self._surroundings = None  # rho_O and rho_B, (bins**3,)
-        self._means = None  # (mean beta per window position, origin, region centre, model px per image px, angle)
+        # (mean beta per window position, origin, region centre, model px per image px, angle)
+        self._means = None
 
     @property
     def trained(self) -> bool:
@@ -72,7 +107,8 @@ class ColourModel:
         return self._target is not None
 
     def init(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
-        """Learn the histograms from the window of the first frame.
+        """
+        Learn the histograms from the window of the first frame.
 
         Parameters
         ----------
@@ -84,13 +120,15 @@ class ColourModel:
             (w, h) window size, image pixels.
         angle : float, optional
             The window's turn, radians.
+
         """
         self._target, self._surroundings = self._histograms(frame, center, size, angle)
         self._beta = _beta(self._target, self._surroundings)
         self._means = None
 
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
-        """Blend in the histograms at the tracked window.
+        """
+        Blend in the histograms at the tracked window.
 
         Parameters
         ----------
@@ -102,6 +140,7 @@ class ColourModel:
             (w, h) window size, image pixels.
         angle : float, optional
             The window's turn, radians.
+
         """
         target, surroundings = self._histograms(frame, center, size, angle)
         eta = self.learning_rate
@@ -110,9 +149,11 @@ class ColourModel:
         self._beta = _beta(self._target, self._surroundings)
 
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
-        """Displacement to the window of highest mean beta in the search region around the predicted window.
+        """
+        Return the displacement to the window of highest mean beta in the search region.
 
-        The map of mean beta is kept for :meth:`score_at`.
+        The region is the one around the predicted window; the map of mean beta is kept for
+        :meth:`score_at`.
 
         Parameters
         ----------
@@ -134,26 +175,30 @@ class ColourModel:
         ------
         RuntimeError
             Before :meth:`init`.
+
         """
         if not self.trained:
-            raise RuntimeError("ColourModel.estimate() called before init()")
+            raise RuntimeError('ColourModel.estimate() called before init()')
         size = np.asarray(size, dtype=np.float64)
         region = 2.0 * size + 2.0 * self.padding * np.sqrt(size[0] * size[1])
         bins, scale = self._bin_indices(frame, center, region, angle)
         beta = self._beta[bins]
         integral = cv2.integral(beta, sdepth=cv2.CV_64F)
         ww, wh = (max(1, int(round(v))) for v in size * scale)
-        sums = integral[wh:, ww:] - integral[:-wh, ww:] - integral[wh:, :-ww] + integral[:-wh, :-ww]
+        sums = (
+            integral[wh:, ww:] - integral[:-wh, ww:] - integral[wh:, :-ww] + integral[:-wh, :-ww]
+        )
         means = sums / (ww * wh)
-        # Window position (row r, column c) is centred at model pixel (c + (ww-1)/2, r + (wh-1)/2); its offset
-        # from the region's centre ((W-1)/2, (H-1)/2) is origin + (c, r).
+        # Window position (row r, column c) is centred at model pixel (c + (ww-1)/2, r + (wh-1)/2);
+        # its offset from the region's centre ((W-1)/2, (H-1)/2) is origin + (c, r).
         origin = np.array([(ww - beta.shape[1]) / 2.0, (wh - beta.shape[0]) / 2.0])
         self._means = (means, origin, np.asarray(center, dtype=np.float64), scale, angle)
         r, c = np.unravel_index(int(np.argmax(means)), means.shape)
         return window_axes(angle) @ ((origin + [c, r]) / scale)
 
     def score_at(self, point) -> float:
-        """The last estimate's mean beta of the window centred at an image point.
+        """
+        Return the last estimate's mean beta of the window centred at an image point.
 
         Parameters
         ----------
@@ -169,11 +214,14 @@ class ColourModel:
         ------
         RuntimeError
             Before an :meth:`estimate`.
+
         """
         if self._means is None:
-            raise RuntimeError("ColourModel.score_at() needs an estimate() first")
+            raise RuntimeError('ColourModel.score_at() needs an estimate() first')
         means, origin, center, scale, angle = self._means
-        c, r = window_axes(angle).T @ (np.asarray(point, dtype=np.float64) - center) * scale - origin
+        c, r = (
+            window_axes(angle).T @ (np.asarray(point, dtype=np.float64) - center) * scale - origin
+        )
         rows, cols = means.shape
         if not (0.0 <= c <= cols - 1 and 0.0 <= r <= rows - 1):
             return 0.0
@@ -185,8 +233,11 @@ class ColourModel:
         return float((1.0 - fr) * top + fr * bottom)
 
     def _histograms(self, frame, center, size, angle):
-        """rho_O and rho_B: the colour-bin fractions of the window and of its surroundings (the window grown by
-        half its mean side, less the window)."""
+        """
+        rho_O and rho_B: the colour-bin fractions of the window and of its surroundings.
+
+        The surroundings are the window grown by half its mean side, less the window.
+        """
         size = np.asarray(size, dtype=np.float64)
         bins, scale = self._bin_indices(frame, center, size + 0.5 * (size[0] + size[1]), angle)
         h, w = bins.shape
@@ -199,11 +250,17 @@ class ColourModel:
         return target / max(target.sum(), 1.0), surroundings / max(surroundings.sum(), 1.0)
 
     def _bin_indices(self, frame, center, region, angle) -> tuple[np.ndarray, float]:
-        """The region (w, h) around ``center`` in the axes of a window turned by ``angle``, resampled (nearest
-        neighbour) to at most ``model_area`` pixels, as colour-bin indices; and the scale (model px per image px)."""
+        """
+        Return the colour-bin indices of the region (w, h) around ``center``, and the scale.
+
+        The region is taken in the axes of a window turned by ``angle`` and resampled (nearest
+        neighbour) to at most ``model_area`` pixels; the scale is model px per image px.
+        """
         scale = min(1.0, np.sqrt(self.model_area / (region[0] * region[1])))
         out_size = [max(1, int(round(v * scale))) for v in region]
-        sample = warp_window(frame, center, window_axes(angle) / scale, out_size, cv2.INTER_NEAREST)
+        sample = warp_window(
+            frame, center, window_axes(angle) / scale, out_size, cv2.INTER_NEAREST
+        )
         q = (sample >> self._shift).astype(np.intp)
         return (q[..., 0] * self.bins + q[..., 1]) * self.bins + q[..., 2], scale
 

@@ -1,27 +1,61 @@
-"""Earth Mover's Distance between target and candidate histograms (section 3).
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
-The transportation problem of eqs. (4)-(8) is solved with POT's network simplex (``ot.emd``'s solver ``emd_c``),
-which returns the optimal flow and the dual potentials ``u`` (target bins) and ``v`` (candidate bins) of eq. (dual).
-By strong duality ``D* = <u, w_T> + <v, w_C>``, so ``v`` is the vector ``M`` of eq. (9) that expresses the EMD as a
-linear function of the candidate weights on the optimal basis, and the paper's gradient eq. (10) is
-``sum_v v_v dw_C,v/dy``.  Non-optimal solver exits are reported in :class:`EmdSolution`, never hidden.  Both
-histograms are normalized and all their mass is moved, as in the paper (docs/decisions.md#emd-solver).
+"""
+Earth Mover's Distance between target and candidate histograms (section 3).
+
+The transportation problem of eqs. (4)-(8) is solved with POT's network simplex (``ot.emd``'s
+solver ``emd_c``), which returns the optimal flow and the dual potentials ``u`` (target bins) and
+``v`` (candidate bins) of eq. (dual).  By strong duality ``D* = <u, w_T> + <v, w_C>``, so ``v`` is
+the vector ``M`` of eq. (9) that expresses the EMD as a linear function of the candidate weights on
+the optimal basis, and the paper's gradient eq. (10) is ``sum_v v_v dw_C,v/dy``.  Non-optimal
+solver exits are reported in :class:`EmdSolution`, never hidden.  Both histograms are normalized
+and all their mass is moved, as in the paper (docs/decisions.md#emd-solver).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
-# POT's network simplex without the backend dispatch of ``ot.emd`` around it (docs/decisions.md#emd-solver)
+
+# POT's network simplex without the backend dispatch of ``ot.emd`` around it
+# (docs/decisions.md#emd-solver)
 from ot.lp.emd_wrap import emd_c
 
-_RESULT_MESSAGES = {0: "infeasible", 1: "optimal", 2: "unbounded",
-                    3: "max_iter reached before optimality"}
+_RESULT_MESSAGES = {0: 'infeasible', 1: 'optimal', 2: 'unbounded',
+                    3: 'max_iter reached before optimality'}
 
 
 @dataclass
 class EmdSolution:
-    """Result of :func:`solve_emd`: the optimal transport and its duals.
+    """
+    Result of :func:`solve_emd`: the optimal transport and its duals.
 
     Parameters
     ----------
@@ -36,9 +70,11 @@ class EmdSolution:
     optimal : bool
         Whether the solver ended optimal.
     message : str
-        The solver's exit in words ("optimal", "infeasible", "unbounded", "max_iter reached before optimality", or
-        the result code).
+        The solver's exit in words ("optimal", "infeasible", "unbounded", "max_iter reached before
+        optimality", or the result code).
+
     """
+
     value: float  # D*, eq. (4)
     flow: np.ndarray  # f_uv, (N_T, N_C)
     u: np.ndarray  # dual potentials of the target constraints, eq. (6)
@@ -48,7 +84,10 @@ class EmdSolution:
 
 
 def ground_distance(eps_t, pos_t, eps_c, pos_c, alpha: float) -> np.ndarray:
-    """Ground distance d_uv = alpha ||eps_u - eps_v||^2 + (1 - alpha) ||c_u - c_v||^2 (eq. ground distance).
+    """
+    Ground distance d_uv = alpha ||eps_u - eps_v||^2 + (1 - alpha) ||c_u - c_v||^2.
+
+    The paper's eq. (ground distance).
 
     Parameters
     ----------
@@ -67,12 +106,18 @@ def ground_distance(eps_t, pos_t, eps_c, pos_c, alpha: float) -> np.ndarray:
     -------
     ndarray
         (N_T, N_C) distances.
+
     """
-    return alpha * appearance_distance(eps_t, eps_c) + (1.0 - alpha) * spatial_distance(pos_t, pos_c)
+    return alpha * appearance_distance(eps_t, eps_c) + (1.0 - alpha) * spatial_distance(
+        pos_t, pos_c
+    )
 
 
 def appearance_distance(eps_t, eps_c, sq_norms_t=None) -> np.ndarray:
-    """Squared appearance distances ||eps_u - eps_v||^2 for all pairs (rows of ``eps_t`` x rows of ``eps_c``).
+    """
+    Squared appearance distances ||eps_u - eps_v||^2 for all pairs.
+
+    The pairs are rows of ``eps_t`` x rows of ``eps_c``.
 
     Parameters
     ----------
@@ -87,6 +132,7 @@ def appearance_distance(eps_t, eps_c, sq_norms_t=None) -> np.ndarray:
     -------
     ndarray
         (N_T, N_C) squared distances (negative rounding clipped to 0).
+
     """
     if sq_norms_t is None:
         sq_norms_t = (eps_t**2).sum(1)
@@ -95,7 +141,8 @@ def appearance_distance(eps_t, eps_c, sq_norms_t=None) -> np.ndarray:
 
 
 def spatial_distance(pos_t, pos_c) -> np.ndarray:
-    """Squared distances ||c_u - c_v||^2 for all pairs of positions.
+    """
+    Squared distances ||c_u - c_v||^2 for all pairs of positions.
 
     Parameters
     ----------
@@ -106,14 +153,17 @@ def spatial_distance(pos_t, pos_c) -> np.ndarray:
     -------
     ndarray
         (N_T, N_C) squared distances.
+
     """
     diff = pos_t[:, None, :] - pos_c[None, :, :]
     return (diff**2).sum(-1)
 
 
-def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int = 100000,
-              check: bool = True) -> EmdSolution:
-    """Optimal transport of the normalized weights ``w_t`` onto ``w_c`` under ``cost``.
+def solve_emd(
+    w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int = 100000, check: bool = True
+) -> EmdSolution:
+    """
+    Optimal transport of the normalized weights ``w_t`` onto ``w_c`` under ``cost``.
 
     Parameters
     ----------
@@ -126,8 +176,8 @@ def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int 
     max_iter : int, optional
         Most iterations of the network simplex.
     check : bool, optional
-        Check the inputs and repair the duals of zero-weight bins; False skips both, for callers that build valid inputs
-        with positive weights only, like the candidate model.
+        Check the inputs and repair the duals of zero-weight bins; False skips both, for callers
+        that build valid inputs with positive weights only, like the candidate model.
 
     Returns
     -------
@@ -137,14 +187,17 @@ def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int 
     Raises
     ------
     ValueError
-        With ``check``, for weights that are negative, not finite or of different totals, or a cost matrix that does
-        not match them or is not finite.
+        With ``check``, for weights that are negative, not finite or of different totals, or a cost
+        matrix that does not match them or is not finite.
+
     """
     w_t = np.asarray(w_t, dtype=np.float64)
     w_c = np.asarray(w_c, dtype=np.float64)
     if check:
         _check_problem(w_t, w_c, cost)
-    flow, value, u, v, code = emd_c(w_t, w_c, np.ascontiguousarray(cost, dtype=np.float64), max_iter, 1)
+    flow, value, u, v, code = emd_c(
+        w_t, w_c, np.ascontiguousarray(cost, dtype=np.float64), max_iter, 1
+    )
     # The network simplex drops zero-weight bins and leaves their duals arbitrary;
     # the tightest feasible ones keep every reduced cost d_uv - u_u - v_v >= 0.
     # (Unchecked callers pass positive weights only.)
@@ -152,23 +205,32 @@ def solve_emd(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray, max_iter: int 
         u = np.where(w_t > 0, u, (cost[:, w_c > 0] - v[w_c > 0]).min(axis=1))
     if check and np.any(w_c == 0) and np.any(w_t > 0):
         v = np.where(w_c > 0, v, (cost[w_t > 0] - u[w_t > 0, None]).min(axis=0))
-    return EmdSolution(value=float(value), flow=flow, u=u, v=v, optimal=code == 1,
-                       message=_RESULT_MESSAGES.get(int(code), f"solver result code {code}"))
+    return EmdSolution(
+        value=float(value),
+        flow=flow,
+        u=u,
+        v=v,
+        optimal=code == 1,
+        message=_RESULT_MESSAGES.get(int(code), f'solver result code {code}'),
+    )
 
 
 def _check_problem(w_t: np.ndarray, w_c: np.ndarray, cost: np.ndarray) -> None:
     if cost.shape != (w_t.size, w_c.size):
-        raise ValueError(f"cost matrix {cost.shape} does not match weights {w_t.size} x {w_c.size}")
+        raise ValueError(
+            f'cost matrix {cost.shape} does not match weights {w_t.size} x {w_c.size}'
+        )
     if not (np.all(np.isfinite(w_t)) and np.all(np.isfinite(w_c)) and np.all(np.isfinite(cost))):
-        raise ValueError("EMD weights and costs must be finite")
+        raise ValueError('EMD weights and costs must be finite')
     if w_t.min() < 0 or w_c.min() < 0:
-        raise ValueError("EMD weights must be non-negative")
+        raise ValueError('EMD weights must be non-negative')
     if abs(w_t.sum() - w_c.sum()) > 1e-9 * max(1.0, w_t.sum()):
-        raise ValueError(f"EMD needs equal total weights, got {w_t.sum()} and {w_c.sum()}")
+        raise ValueError(f'EMD needs equal total weights, got {w_t.sum()} and {w_c.sum()}')
 
 
 def emd_gradient(solution: EmdSolution, dw_c_dy: np.ndarray) -> np.ndarray:
-    """The paper's eq. (10): dD*/dy = sum_v v_v dw_C,v/dy.
+    """
+    Return the paper's eq. (10): dD*/dy = sum_v v_v dw_C,v/dy.
 
     Parameters
     ----------
@@ -181,5 +243,6 @@ def emd_gradient(solution: EmdSolution, dw_c_dy: np.ndarray) -> np.ndarray:
     -------
     ndarray
         (2,) gradient.
+
     """
     return solution.v @ dw_c_dy

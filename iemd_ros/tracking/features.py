@@ -1,31 +1,64 @@
-"""Hand-crafted features of the correlation filters: fHOG, Colour Names and grey, on 4x4 cells.
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
+"""
+Hand-crafted features of the correlation filters: fHOG, Colour Names and grey, on 4x4 cells.
 
 Maps are channel-first, ``(C, rows, cols)`` float32, one value per ``cell x cell`` block of pixels
 (``rows = H // cell``; pixels beyond the last full cell are ignored).
 
-* fHOG: Felzenszwalb et al.'s 31-channel HOG ("Object Detection with Discriminatively Trained Part-Based Models",
-  TPAMI 2010, sec. 6) as Piotr Dollar's ``fhog`` computes it, the feature of DSST, SRDCF, BACF, STRCF, ECO-HC,
-  ARCF and AutoTrack: the gradient by centred differences per colour channel, keeping the channel of largest
-  magnitude; its signed orientation to the nearest of 18 bins, the vote (magnitude / cell^2) split bilinearly
-  between the 4 nearest cells; the 9 contrast-insensitive histograms; four 2x2-block normalizations per cell;
-  18 signed + 9 unsigned channels of the normalized values clipped at 0.2, and 4 texture channels.
-* Colour Names: the 10-channel normalized CN of van de Weijer et al. (TIP 2009) in the form of Danelljan et al.
-  (CVPR 2014), from the table ``data/colour_names.npy`` (row of an 8-bit pixel: ``R//8 + 32 G//8 + 1024 B//8``),
-  averaged over the cell; and grey ``gray / 255 - 0.5`` averaged over the cell.
+* fHOG: Felzenszwalb et al.'s 31-channel HOG ("Object Detection with Discriminatively Trained
+  Part-Based Models", TPAMI 2010, sec. 6) as Piotr Dollar's ``fhog`` computes it, the feature of
+  DSST, SRDCF, BACF, STRCF, ECO-HC, ARCF and AutoTrack: the gradient by centred differences per
+  colour channel, keeping the channel of largest magnitude; its signed orientation to the nearest
+  of 18 bins, the vote (magnitude / cell^2) split bilinearly between the 4 nearest cells; the 9
+  contrast-insensitive histograms; four 2x2-block normalizations per cell; 18 signed + 9 unsigned
+  channels of the normalized values clipped at 0.2, and 4 texture channels.
+* Colour Names: the 10-channel normalized CN of van de Weijer et al. (TIP 2009) in the form of
+  Danelljan et al. (CVPR 2014), from the table ``data/colour_names.npy`` (row of an 8-bit pixel:
+  ``R//8 + 32 G//8 + 1024 B//8``), averaged over the cell; and grey ``gray / 255 - 0.5`` averaged
+  over the cell.
 
-:func:`extract` stacks grey (1) + fHOG (31) + CN (10) = 42 channels on colour frames and grey + fHOG = 32 on grey
-frames (CN carries nothing on a grey pixel): the feature set of STRCF and AutoTrack.
+:func:`extract` stacks grey (1) + fHOG (31) + CN (10) = 42 channels on colour frames and grey +
+fHOG = 32 on grey frames (CN carries nothing on a grey pixel): the feature set of STRCF and
+AutoTrack.
 """
 from __future__ import annotations
 
-import math
 from functools import cache
+import math
 from pathlib import Path
 
 import numba
 import numpy as np
 
-__all__ = ["N_HOG", "N_CN", "CELL", "colour_names", "fhog", "fhog_batch", "n_channels", "extract"]
+__all__ = ['N_HOG', 'N_CN', 'CELL', 'colour_names', 'fhog', 'fhog_batch', 'n_channels', 'extract']
 
 N_HOG = 31
 N_CN = 10
@@ -34,14 +67,24 @@ CELL = 4  # pixels per cell side
 
 @cache
 def colour_names() -> np.ndarray:
-    """The (32768, 10) float32 Colour Names table (``data/colour_names.npy``, see ``data/README.md``)."""
-    return np.ascontiguousarray(np.load(Path(__file__).with_name("data") / "colour_names.npy"), dtype=np.float32)
+    """
+    Return the (32768, 10) float32 Colour Names table.
+
+    It is loaded from ``data/colour_names.npy`` (see ``data/README.md``).
+    """
+    return np.ascontiguousarray(
+        np.load(Path(__file__).with_name('data') / 'colour_names.npy'), dtype=np.float32
+    )
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _atan2_pos(y, x):
-    """``atan2(y, x)`` mapped to [0, 2 pi): octant reduction + a degree-7 odd polynomial for atan on [0, 1]
-    (max error 2e-4 rad = 0.01 deg, far below the 20 deg bin width; Piotr's toolbox also uses a table)."""
+    """
+    ``atan2(y, x)`` mapped to [0, 2 pi).
+
+    Octant reduction + a degree-7 odd polynomial for atan on [0, 1] (max error 2e-4 rad = 0.01 deg,
+    far below the 20 deg bin width; Piotr's toolbox also uses a table).
+    """
     ax = abs(x)
     ay = abs(y)
     mx = max(ax, ay)
@@ -62,8 +105,12 @@ def _atan2_pos(y, x):
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _grad_bins(img, cell, O0, M0):
-    """Per pixel: the nearest of 18 orientation bins ``O0`` and the vote ``M0`` (magnitude / cell^2) of the colour
-    channel of largest gradient (centred differences, one-sided at the border)."""
+    """
+    Per pixel: the nearest of 18 orientation bins ``O0`` and the vote ``M0`` (magnitude / cell^2).
+
+    Both are those of the colour channel of largest gradient (centred differences, one-sided at
+    the border).
+    """
     H, W, C = img.shape
     norm = 1.0 / (cell * cell)
     omult = 18.0 / (2.0 * math.pi)
@@ -97,9 +144,13 @@ def _grad_bins(img, cell, O0, M0):
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _accumulate(O0, M0, cell, R):
-    """Spatially bilinear votes into the 4 nearest cells.
-    ``R`` is (hb + 2, wb + 2, 18), one cell of padding each side catching the votes that fall outside the
-    map.  (Direct 3-D indexing: keeping row views in variables costs numba reference counting.)"""
+    """
+    Spatially bilinear votes into the 4 nearest cells.
+
+    ``R`` is (hb + 2, wb + 2, 18), one cell of padding each side catching the votes that fall
+    outside the map.  (Direct 3-D indexing: keeping row views in variables costs numba reference
+    counting.)
+    """
     H, W = O0.shape
     hb = H // cell
     wb = W // cell
@@ -122,7 +173,11 @@ def _accumulate(O0, M0, cell, R):
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _fhog_into(img, cell, clip, out, off):
-    """Write the 31 fHOG channels of ``img`` (H, W, C) float32 into ``out[off:off+31]`` (see module doc)."""
+    """
+    Write the 31 fHOG channels of ``img`` (H, W, C) float32 into ``out[off:off+31]``.
+
+    See the module docstring.
+    """
     H, W, C = img.shape
     hb = H // cell
     wb = W // cell
@@ -145,12 +200,15 @@ def _fhog_into(img, cell, clip, out, off):
                 v = R1[o, i, j] + R1[o + 9, i, j]
                 R2[o, i, j] = v
                 E[i, j] += v * v
-    # block normalization factors: block (i, j) = cells (i..i+1, j..j+1); index (i+1, j+1) of N; edges replicated
+    # block normalization factors: block (i, j) = cells (i..i+1, j..j+1); index (i+1, j+1) of N;
+    # edges replicated
     eps = 1e-4 / 4.0 / cell / cell / cell / cell
     N = np.zeros((hb + 1, wb + 1), np.float32)
     for i in range(hb - 1):
         for j in range(wb - 1):
-            N[i + 1, j + 1] = 1.0 / math.sqrt(E[i, j] + E[i + 1, j] + E[i, j + 1] + E[i + 1, j + 1] + eps)
+            N[i + 1, j + 1] = 1.0 / math.sqrt(
+                E[i, j] + E[i + 1, j] + E[i, j + 1] + E[i + 1, j + 1] + eps
+            )
     for i in range(hb + 1):
         for j in range(wb + 1):
             ii = min(max(i, 1), hb - 1)
@@ -181,8 +239,9 @@ def _fhog_into(img, cell, clip, out, off):
                 t3 += a3
             for o in range(9):
                 v = R2[o, i, j]
-                out[off + 18 + o, i, j] = 0.5 * (min(v * n0, clip) + min(v * n1, clip)
-                                                 + min(v * n2, clip) + min(v * n3, clip))
+                out[off + 18 + o, i, j] = 0.5 * (
+                    min(v * n0, clip) + min(v * n1, clip) + min(v * n2, clip) + min(v * n3, clip)
+                )
             out[off + 27, i, j] = r * t0
             out[off + 28, i, j] = r * t1
             out[off + 29, i, j] = r * t2
@@ -190,12 +249,14 @@ def _fhog_into(img, cell, clip, out, off):
 
 
 def fhog(img: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
-    """Felzenszwalb's 31-channel HOG of an image.
+    """
+    Felzenszwalb's 31-channel HOG of an image.
 
     Parameters
     ----------
     img : ndarray
-        (H, W) or (H, W, C) image, any numeric type (uint8 images on their 0-255 scale), at least 2x2.
+        (H, W) or (H, W, C) image, any numeric type (uint8 images on their 0-255 scale), at least
+        2x2.
     cell : int
         Cell side, px.
     clip : float
@@ -205,13 +266,14 @@ def fhog(img: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
     -------
     ndarray
         (31, H // cell, W // cell) float32.
+
     """
     a = np.asarray(img, dtype=np.float32)
     if a.ndim == 2:
         a = a[:, :, None]
     a = np.ascontiguousarray(a)
     if a.shape[0] < 2 or a.shape[1] < 2:
-        raise ValueError(f"fhog needs an image of at least 2x2 pixels, got {a.shape[:2]}")
+        raise ValueError(f'fhog needs an image of at least 2x2 pixels, got {a.shape[:2]}')
     out = np.zeros((N_HOG, a.shape[0] // cell, a.shape[1] // cell), np.float32)
     _fhog_into(a, cell, np.float32(clip), out, 0)
     return out
@@ -219,7 +281,12 @@ def fhog(img: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _colour_into(bgr, cell, table, use_cn, out, grey_ch, cn_off):
-    """Per-cell mean of grey/255 - 0.5 into ``out[grey_ch]`` and of the CN table rows into ``out[cn_off:+10]``."""
+    """
+    Write the per-cell means of grey and of the CN table rows into ``out``.
+
+    The mean of grey/255 - 0.5 goes into ``out[grey_ch]``, that of the CN table rows into
+    ``out[cn_off:+10]``.
+    """
     H, W, C = bgr.shape
     hb = H // cell
     wb = W // cell
@@ -252,12 +319,17 @@ def _colour_into(bgr, cell, table, use_cn, out, grey_ch, cn_off):
 
 
 def n_channels(colour: bool) -> int:
-    """Number of channels :func:`extract` returns: 42 on colour frames, 32 on grey ones."""
+    """Return how many channels :func:`extract` returns: 42 on colour frames, 32 on grey ones."""
     return 1 + N_HOG + (N_CN if colour else 0)
 
 
-def extract(patch_bgr: np.ndarray, colour: bool, cell: int = CELL, out: np.ndarray | None = None) -> np.ndarray:
-    """Grey + fHOG (+ Colour Names on colour frames) of a uint8 patch, ``(C, H // cell, W // cell)`` float32.
+def extract(
+    patch_bgr: np.ndarray, colour: bool, cell: int = CELL, out: np.ndarray | None = None
+) -> np.ndarray:
+    """
+    Grey + fHOG (+ Colour Names on colour frames) of a uint8 patch.
+
+    The map is ``(C, H // cell, W // cell)`` float32.
 
     Parameters
     ----------
@@ -274,6 +346,7 @@ def extract(patch_bgr: np.ndarray, colour: bool, cell: int = CELL, out: np.ndarr
     -------
     ndarray
         The feature map (``out`` when given).
+
     """
     a = np.ascontiguousarray(patch_bgr)
     if a.ndim == 2:
@@ -295,7 +368,11 @@ def _fhog_batch(patches, cell, clip, out):
 
 
 def fhog_batch(patches: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
-    """fHOG of K equally sized patches ``(K, H, W[, C])`` in one call, ``(K, 31, H // cell, W // cell)`` float32."""
+    """
+    Return the fHOG of K equally sized patches ``(K, H, W[, C])`` in one call.
+
+    The maps are ``(K, 31, H // cell, W // cell)`` float32.
+    """
     p = np.ascontiguousarray(patches, dtype=np.float32)
     if p.ndim == 3:
         p = p[..., None]

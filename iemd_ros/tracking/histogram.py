@@ -1,13 +1,47 @@
-"""Kernel-weighted histograms of sparse codes: eqs. (sparse target model) and (sparse candidate model).
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
+"""
+Kernel-weighted histograms of sparse codes.
+
+Those of eqs. (sparse target model) and (sparse candidate model).
 
 Bin r carries the pooled code weight ``p_r`` (or ``q_r``) of patch r and the Epanechnikov profile
-``k(x) = max(0, 1 - x)`` of its squared normalized distance to the window centre, ``x = ||(c_r - y) / h||^2``.
+``k(x) = max(0, 1 - x)`` of its squared normalized distance to the window centre,
+``x = ||(c_r - y) / h||^2``.
 
-Section 4's index u of ``p_ru`` is read as: every patch is a bin, with its own appearance and position in the
-ground distance (docs/decisions.md#histogram-bins).  Positions are in normalized window units (the window is
-[-1, 1]^2); the paper only says "h is template size", and h = 1 is the ellipse inscribed in the window, where the
-corner patches of the 8x8/step-4 layout get no weight (docs/decisions.md#kernel-bandwidth).  The kernel is not
-scaled with the window: the scale search resamples the window instead.
+Section 4's index u of ``p_ru`` is read as: every patch is a bin, with its own appearance and
+position in the ground distance (docs/decisions.md#histogram-bins).  Positions are in normalized
+window units (the window is [-1, 1]^2); the paper only says "h is template size", and h = 1 is the
+ellipse inscribed in the window, where the corner patches of the 8x8/step-4 layout get no weight
+(docs/decisions.md#kernel-bandwidth).  The kernel is not scaled with the window: the scale search
+resamples the window instead.
 """
 from __future__ import annotations
 
@@ -16,7 +50,10 @@ import numpy as np
 
 
 def target_weights(code_weights: np.ndarray, pos: np.ndarray, bandwidth: float) -> np.ndarray:
-    """Target histogram w_T,u = gamma k(||c_u/h||^2) |p_u|, normalized to sum 1 (eq. sparse target model).
+    """
+    Target histogram w_T,u = gamma k(||c_u/h||^2) |p_u|.
+
+    It is normalized to sum 1 (eq. sparse target model).
 
     The candidate weights of the same patches with the kernel at the window centre (y = 0).
 
@@ -38,18 +75,22 @@ def target_weights(code_weights: np.ndarray, pos: np.ndarray, bandwidth: float) 
     ------
     ValueError
         When the histogram is empty (no patch with a non-zero code inside the kernel).
+
     """
     w, _ = candidate_weights(code_weights, pos, np.zeros(2), bandwidth)
     if not w.any():
-        raise ValueError("target histogram is empty (no patch with a non-zero code inside the kernel)")
+        raise ValueError(
+            'target histogram is empty (no patch with a non-zero code inside the kernel)'
+        )
     return w
 
 
 def candidate_weights(code_weights, pos, y, bandwidth):
-    """Candidate histogram w_C,v(y) of eq. (sparse candidate model) and its Jacobian dw_C,v/dy.
+    """
+    Candidate histogram w_C,v(y) of eq. (sparse candidate model) and its Jacobian dw_C,v/dy.
 
-    The normalization gamma(y) is differentiated too, so sum_v dw_v/dy = 0 and the gradient does not depend on the
-    arbitrary constant of the duals.
+    The normalization gamma(y) is differentiated too, so sum_v dw_v/dy = 0 and the gradient does
+    not depend on the arbitrary constant of the duals.
 
     Parameters
     ----------
@@ -68,9 +109,14 @@ def candidate_weights(code_weights, pos, y, bandwidth):
         (N,) weights summing to 1 (all zeros if no patch is inside the kernel).
     dw_dy : ndarray
         (N, 2) their Jacobian.
+
     """
-    return _candidate_weights(np.asarray(code_weights, dtype=np.float64), np.asarray(pos, dtype=np.float64),
-                              np.asarray(y, dtype=np.float64), float(bandwidth))
+    return _candidate_weights(
+        np.asarray(code_weights, dtype=np.float64),
+        np.asarray(pos, dtype=np.float64),
+        np.asarray(y, dtype=np.float64),
+        float(bandwidth),
+    )
 
 
 @numba.njit(cache=True)

@@ -1,26 +1,63 @@
-"""The iEMD tracker: Algorithm 1 with the extensions of sections 5.1 and 6.1 and discriminative models around it.
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
+"""
+The iEMD tracker.
+
+Algorithm 1 with the extensions of sections 5.1 and 6.1 and discriminative models around it.
 
 OpenCV-style API: ``init(frame, box)`` then ``update(frame, prior=None)``.
 
-Per frame: the starts (the prediction, the optical flow's, the translation filter's and the colour model's
-windows) are scored; the best by EMD and the best by the search's score are descended (Algorithm 1: build the
-candidate model at the window, solve the EMD, move against its gradient while it decreases); the descended window
-of lower score is kept, preferring one the occlusion check accepts; then the scale is estimated at it, and the
-models learn unless the frame is held or lost.
+Per frame: the starts (the prediction, the optical flow's, the translation filter's and the colour
+model's windows) are scored; the best by EMD and the best by the search's score are descended
+(Algorithm 1: build the candidate model at the window, solve the EMD, move against its gradient
+while it decreases); the descended window of lower score is kept, preferring one the occlusion
+check accepts; then the scale is estimated at it, and the models learn unless the frame is held or
+lost.
 """
 from __future__ import annotations
 
-import enum
-import functools
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
+import enum
+import functools
 
 import cv2
-import numpy as np
-
 from iemd_ros.common.boxes import box_centre, centre_box, check_box
 from iemd_ros.common.limits import TARGET_SIDE
-from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, grey_levels, to_gray, window_axes
+from iemd_ros.tracking.appearance import (
+    grey_levels,
+    ImagePyramid,
+    PatchLayout,
+    to_gray,
+    window_axes,
+)
 from iemd_ros.tracking.candidate import CandidateModel, SearchContext, TargetModel
 from iemd_ros.tracking.colour_model import ColourModel
 from iemd_ros.tracking.config import ScaleEstimator, TrackerConfig
@@ -28,23 +65,36 @@ from iemd_ros.tracking.flow import window_flow
 from iemd_ros.tracking.scale_filter import ScaleFilter
 from iemd_ros.tracking.template import TemplateDictionary
 from iemd_ros.tracking.translation_filter import TranslationFilter
+import numpy as np
 
-__all__ = ["IemdTracker", "TrackResult", "Cause", "warm_up"]
+__all__ = ['IemdTracker', 'TrackResult', 'Cause', 'warm_up']
 
-MIN_SIDE_PX = 4.0  # the scale search never shrinks a window's shorter side below this (image pixels)
-CONFIDENCE_RATE = 0.1  # learning rate of the running mean that update_confidence compares the response with
+# the scale search never shrinks a window's shorter side below this (image pixels)
+MIN_SIDE_PX = 4.0
+# learning rate of the running mean that update_confidence compares the response with
+CONFIDENCE_RATE = 0.1
 WORKERS = 2  # threads the independent models of a frame run on (this machine class: 2 cores)
-FRAME_SEARCH_AFTER = 5  # lost frames searched only around the prediction before the whole frame is searched too
+# lost frames searched only around the prediction before the whole frame is searched too
+FRAME_SEARCH_AFTER = 5
 
 
 class Cause(enum.Enum):
-    """Why a frame was lost or held (TrackResult.cause); TrackResult.reason words it with the figures."""
+    """
+    Why a frame was lost or held (TrackResult.cause).
 
-    OUT_OF_VIEW = "out of view"                          # too little of the window inside the image
-    EMD_ABOVE_BACKGROUND = "EMD above the background's"  # the window no longer looks like the target
-    LOW_RESPONSE = "low filter response"                 # held: the occlusion check
-    NO_PEAK = "no filter peak"                           # the filter's peak far below its running mean
-    REDETECTED = "re-detected"                           # found again while lost (not learned from)
+    TrackResult.reason words it with the figures.
+    """
+
+    # too little of the window inside the image
+    OUT_OF_VIEW = 'out of view'
+    # the window no longer looks like the target
+    EMD_ABOVE_BACKGROUND = "EMD above the background's"
+    # held: the occlusion check
+    LOW_RESPONSE = 'low filter response'
+    # the filter's peak far below its running mean
+    NO_PEAK = 'no filter peak'
+    # found again while lost (not learned from)
+    REDETECTED = 're-detected'
 
 
 @dataclass
@@ -56,13 +106,17 @@ class TrackResult:
     iterations: int  # descent iterations of the chosen start
     lost: bool
     scale: float = 1.0  # relative scale change chosen this frame
-    angle: float = 0.0  # orientation of the tracked window (radians, from the priors); box is its bounding box
-    starts: int = 1  # starting points searched (the prediction, the flow, filter and colour starts, the particles)
+    # orientation of the tracked window (radians, from the priors); box is its bounding box
+    angle: float = 0.0
+    # starting points searched (the prediction, the flow, filter and colour starts, the particles)
+    starts: int = 1
     codings: int = 0  # candidate models built (windows sampled and sparse-coded) this frame
     solver_warnings: int = 0  # EMD solves that did not end optimal
     predicted_box: tuple[float, float, float, float] | None = None
-    reason: str = ""  # why the window counts as lost, or why the models did not learn (held), with the figures
-    held: bool = False  # tracked, but the models did not learn and the size was kept (occlusion check)
+    # why the window counts as lost, or why the models did not learn (held), with the figures
+    reason: str = ''
+    # tracked, but the models did not learn and the size was kept (occlusion check)
+    held: bool = False
     cause: Cause | None = None  # the reason's kind (None: tracked and learned)
 
 
@@ -73,10 +127,13 @@ class _Descent:
     model: CandidateModel  # the window it ended at
     emd: float
     iterations: int = 0
-    codings: int = 0  # candidate models built (_descend: its trial steps; _search adds the starts')
-    warnings: int = 0  # EMD solves that did not end optimal (likewise: the trials', the starts' by _search)
-    confidence: float | None = None  # the filter's response at the window (set by _search: _confidence_check)
-    held_reason: str = ""
+    # candidate models built (_descend: its trial steps; _search adds the starts')
+    codings: int = 0
+    # EMD solves that did not end optimal (likewise: the trials', the starts' by _search)
+    warnings: int = 0
+    # the filter's response at the window (set by _search: _confidence_check)
+    confidence: float | None = None
+    held_reason: str = ''
 
     @property
     def center(self) -> np.ndarray:
@@ -85,7 +142,8 @@ class _Descent:
 
 
 class IemdTracker:
-    """iEMD visual tracker (Yao & Dani): sparse-coding histograms + EMD gradient descent.
+    """
+    iEMD visual tracker (Yao & Dani): sparse-coding histograms + EMD gradient descent.
 
     Parameters
     ----------
@@ -97,18 +155,20 @@ class IemdTracker:
     >>> tracker = IemdTracker()
     >>> tracker.init(frame, (x, y, w, h))         # doctest: +SKIP
     >>> result = tracker.update(next_frame)       # doctest: +SKIP
+
     """
 
     def __init__(self, config: TrackerConfig | None = None):
         self.config = config if config is not None else TrackerConfig()
         if not isinstance(self.config, TrackerConfig):
-            raise ValueError("config must be a TrackerConfig")
+            raise ValueError('config must be a TrackerConfig')
         cfg = self.config
         self.layout = PatchLayout(cfg.template_size, cfg.patch_size, cfg.patch_step)
         self._center = None
         self._size = None
         self._previous = None  # grey levels of the last frame, for the flow start
-        self._angle = 0.0  # orientation of the tracked window (radians), only ever changed by priors
+        # orientation of the tracked window (radians), only ever changed by priors
+        self._angle = 0.0
         self._background_emd = np.inf
         self._frame_index = 0
         self._lost = False
@@ -116,7 +176,8 @@ class IemdTracker:
 
     # ------------------------------------------------------------------ API
     def init(self, frame: np.ndarray, box) -> None:
-        """Start tracking the target in ``box`` = (x, y, w, h) of ``frame``.
+        """
+        Start tracking the target in ``box`` = (x, y, w, h) of ``frame``.
 
         Parameters
         ----------
@@ -128,8 +189,9 @@ class IemdTracker:
         Raises
         ------
         ValueError
-            For a frame that is not such an image, or a box that is not finite, empty, outside the image or larger
-            than it (:data:`~iemd_ros.common.limits.TARGET_SIDE`).
+            For a frame that is not such an image, or a box that is not finite, empty, outside the
+            image or larger than it (:data:`~iemd_ros.common.limits.TARGET_SIDE`).
+
         """
         _check_frame(frame)
         x, y, w, h = _check_box(box, frame.shape)
@@ -140,8 +202,9 @@ class IemdTracker:
         self._previous = None
         _, _, pyramid = self._take_frame(frame)
         template = pyramid.sample(self._center, self._size, cfg.template_size)
-        self.dictionary = TemplateDictionary(self.layout, cfg.n_templates, cfg.lam,
-                                             cfg.forgetting, cfg.reconstruction_lambda)
+        self.dictionary = TemplateDictionary(
+            self.layout, cfg.n_templates, cfg.lam, cfg.forgetting, cfg.reconstruction_lambda
+        )
         self.dictionary.add(template, 0.0, 0)
         self._target_eps = self.layout.extract(template)  # epsilon_u of I_0 (Algorithm 1)
         self._refresh_target()
@@ -158,42 +221,55 @@ class IemdTracker:
         if cfg.colour_weight > 0 and _is_colour(frame):
             self._colour_model = ColourModel()
             self._colour_model.init(frame, self._center, self._size)
-        self._colour_now = False  # the colour model has estimated on this frame (not on a grey frame)
+        # the colour model has estimated on this frame (not on a grey frame)
+        self._colour_now = False
         self._frame_index = 0
         self._lost = False
-        self._confidence = None  # running mean of the filter's response at the window over frames that learned
-        self._search_part = 0  # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
+        # running mean of the filter's response at the window over frames that learned
+        self._confidence = None
+        # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
+        self._search_part = 0
         self._lost_frames = 0  # lost frames in a row
-        self._anchor = None  # lost: where the target was lost, moved by the priors since (re-detection looks there)
+        # lost: where the target was lost, moved by the priors since (re-detection looks there)
+        self._anchor = None
         self._prediction = None  # this frame's predicted centre
 
     def update(self, frame: np.ndarray, prior=None) -> TrackResult:
-        """Track the target into ``frame``.
+        """
+        Track the target into ``frame``.
 
         Parameters
         ----------
         frame : ndarray
             HxW or HxWx3 (BGR) uint8 image, the next frame.
         prior : array_like (3, 3), optional
-            Homography taking the previous frame's pixels to this frame's (the gyro's ``K R^T K^-1``, eq. 23):
-            the prediction moves, turns and scales with it.
+            Homography taking the previous frame's pixels to this frame's (the gyro's ``K R^T
+            K^-1``, eq. 23): the prediction moves, turns and scales with it.
 
         Returns
         -------
         TrackResult
-            The window found, its EMD and what the search cost; ``lost`` / ``held`` with their cause.
+            The window found, its EMD and what the search cost; ``lost`` / ``held`` with their
+            cause.
 
         Raises
         ------
         ValueError
-            For a bad frame or prior (non-finite, singular, or mapping the window to infinity); the tracker's
-            state is then unchanged.
+            For a bad frame or prior (non-finite, singular, or mapping the window to infinity); the
+            tracker's state is then unchanged.
+
         """
         if self._center is None:
-            raise RuntimeError("IemdTracker.update() called before init()")
+            raise RuntimeError('IemdTracker.update() called before init()')
         _check_frame(frame)
-        center, size, angle, anchor = self._center.copy(), self._size.copy(), self._angle, self._anchor
-        if prior is not None:  # may raise ValueError: before any state changes, so a retry sees none
+        center, size, angle, anchor = (
+            self._center.copy(),
+            self._size.copy(),
+            self._angle,
+            self._anchor,
+        )
+        # may raise ValueError: before any state changes, so a retry sees none
+        if prior is not None:
             prior = _check_prior(prior)
             center, size, turn = _apply_prior(prior, center, size)
             angle = _wrap_angle(angle + turn)
@@ -204,27 +280,56 @@ class IemdTracker:
         previous, grey, pyramid = self._take_frame(frame)
         visible = _visible_fraction(center, size, angle, frame.shape)
         cfg = self.config
-        if visible < cfg.min_visible:  # the prior moved the window out of view: keep its place, search only the frame
-            redetected = self._redetect(frame, pyramid, size, angle, predicted, 0, 0) if self._lost else None
-            return redetected or self._lose(center, size, angle, predicted, Cause.OUT_OF_VIEW,
-                                            f"only {visible:.0%} of the predicted window is inside the image")
-        best, searches, starts = self._search_all(frame, previous, grey, pyramid, prior, center, size, angle)
-        final, scale = _Descent(model=best.model, emd=best.emd), 1.0  # held or lost: the window keeps its size
+        # the prior moved the window out of view: keep its place, search only the frame
+        if visible < cfg.min_visible:
+            redetected = (
+                self._redetect(frame, pyramid, size, angle, predicted, 0, 0)
+                if self._lost
+                else None
+            )
+            return redetected or self._lose(
+                center,
+                size,
+                angle,
+                predicted,
+                Cause.OUT_OF_VIEW,
+                f'only {visible:.0%} of the predicted window is inside the image',
+            )
+        best, searches, starts = self._search_all(
+            frame, previous, grey, pyramid, prior, center, size, angle
+        )
+        # held or lost: the window keeps its size
+        final, scale = _Descent(model=best.model, emd=best.emd), 1.0
         if not best.held_reason and not self._lost:
-            final, scale = self._estimate_scale(frame, best, _scale_bounds(best.model.size, frame.shape))
+            final, scale = self._estimate_scale(
+                frame, best, _scale_bounds(best.model.size, frame.shape)
+            )
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
         codings = sum(s.codings for s in searches) + final.codings
         cause, reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
         if cause is None:  # lost until the peak is back to found_response x its mean: hysteresis
-            cause, reason = self._peak_check(cfg.found_response if self._lost else cfg.lost_response)
+            cause, reason = self._peak_check(
+                cfg.found_response if self._lost else cfg.lost_response
+            )
         if cause is not None and self._lost:
             redetected = self._redetect(frame, pyramid, size, angle, predicted, starts, codings)
             if redetected is not None:
                 return redetected
-        if cause is not None:  # the window follows the local search (not out of the image), without learning
+        # the window follows the local search (not out of the image), without learning
+        if cause is not None:
             kept = center if cause is Cause.OUT_OF_VIEW else new_center
-            return self._lose(kept, size, angle, predicted, cause, reason, emd=emd, searched=best, starts=starts,
-                              codings=codings)
+            return self._lose(
+                kept,
+                size,
+                angle,
+                predicted,
+                cause,
+                reason,
+                emd=emd,
+                searched=best,
+                starts=starts,
+                codings=codings,
+            )
         self._lost, self._lost_frames, self._anchor = False, 0, None
         held = bool(best.held_reason)
         self._center, self._size, self._angle = new_center, new_size, angle
@@ -233,50 +338,100 @@ class IemdTracker:
         else:
             self._learn(frame, final, best.confidence, new_center, new_size, angle)
         return TrackResult(
-            box=_box(new_center, new_size, angle), emd=emd, iterations=best.iterations, lost=False, scale=scale,
-            angle=angle, starts=starts, codings=codings,
-            solver_warnings=sum(s.warnings for s in searches) + final.warnings, predicted_box=predicted,
-            reason=reason, held=held, cause=cause,
+            box=_box(new_center, new_size, angle),
+            emd=emd,
+            iterations=best.iterations,
+            lost=False,
+            scale=scale,
+            angle=angle,
+            starts=starts,
+            codings=codings,
+            solver_warnings=sum(s.warnings for s in searches) + final.warnings,
+            predicted_box=predicted,
+            reason=reason,
+            held=held,
+            cause=cause,
         )
 
     # ------------------------------------------------------------ internals
-    def _lose(self, center, size, angle, predicted, cause: Cause, reason: str, emd: float = float("inf"),
-              searched: _Descent | None = None, starts: int = 0, codings: int = 0) -> TrackResult:
-        """The lost frame's result: the window is kept at ``center`` (the prediction, or where the local search took
-        it), so it moves with the prior while lost; on the first lost frame the predicted centre becomes the place
-        re-detection looks at."""
+    def _lose(
+        self,
+        center,
+        size,
+        angle,
+        predicted,
+        cause: Cause,
+        reason: str,
+        emd: float = float('inf'),
+        searched: _Descent | None = None,
+        starts: int = 0,
+        codings: int = 0,
+    ) -> TrackResult:
+        """
+        Return the lost frame's result.
+
+        The window is kept at ``center`` (the prediction, or where the local search took it), so it
+        moves with the prior while lost; on the first lost frame the predicted centre becomes the
+        place re-detection looks at.
+        """
         if not self._lost:
             self._anchor = np.asarray(self._prediction, dtype=np.float64)
         self._center, self._size, self._angle, self._lost = center, size, angle, True
         self._lost_frames += 1
-        return TrackResult(box=_box(center, size, angle), emd=emd, iterations=searched.iterations if searched else 0,
-                           lost=True, angle=angle, starts=starts, codings=codings, predicted_box=predicted,
-                           reason=reason, cause=cause)
+        return TrackResult(
+            box=_box(center, size, angle),
+            emd=emd,
+            iterations=searched.iterations if searched else 0,
+            lost=True,
+            angle=angle,
+            starts=starts,
+            codings=codings,
+            predicted_box=predicted,
+            reason=reason,
+            cause=cause,
+        )
 
     def _peak_check(self, threshold: float) -> tuple[Cause | None, str]:
-        """(NO_PEAK, reason) when the translation filter's peak near the prediction is below ``threshold`` times the
-        running mean of its response on learned frames (LCT's re-detection trigger), else (None, "")."""
+        """
+        (NO_PEAK, reason) when the translation filter's peak near the prediction is too low.
+
+        Too low: below ``threshold`` times the running mean of its response on learned frames
+        (LCT's re-detection trigger).  Else (None, "").
+        """
         if self._translation_filter is None or self._confidence is None:
-            return None, ""
+            return None, ''
         peak = self._translation_filter.response_peak
         if peak >= threshold * self._confidence:
-            return None, ""
-        return Cause.NO_PEAK, f"filter peak {peak:.3f} < {threshold} x its running mean {self._confidence:.3f}"
+            return None, ''
+        return (
+            Cause.NO_PEAK,
+            f'filter peak {peak:.3f} < {threshold} x its running mean {self._confidence:.3f}',
+        )
 
-    def _redetect(self, frame, pyramid, size, angle, predicted, starts: int, codings: int) -> TrackResult | None:
-        """A lost frame the local search did not confirm: the filter searched where the target was lost (that place
-        moved by the priors since), then, lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near
-        where it happened), one strip of the whole frame (the frame is scanned over lost frames) refined by a search
-        at its peak.  The result when the best peak reaches ``found_response`` times the running mean and its
-        window's EMD is below the lost limit, else None.  Nothing learns from the frame."""
+    def _redetect(
+        self, frame, pyramid, size, angle, predicted, starts: int, codings: int
+    ) -> TrackResult | None:
+        """
+        Re-detect the target on a lost frame the local search did not confirm.
+
+        The filter searches where the target was lost (that place moved by the priors since), then,
+        lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near where it
+        happened), one strip of the whole frame (the frame is scanned over lost frames) refined by
+        a search at its peak.  The result when the best peak reaches ``found_response`` times the
+        running mean and its window's EMD is below the lost limit, else None.  Nothing learns from
+        the frame.
+        """
         tf, cfg = self._translation_filter, self.config
-        if tf is None or self._confidence is None:  # no frame learned yet: no response to compare a candidate with
+        # no frame learned yet: no response to compare a candidate with
+        if tf is None or self._confidence is None:
             return None
         wanted = cfg.found_response * self._confidence
         candidates = []  # (centre, filter peak there)
         if _visible_fraction(self._anchor, size, angle, frame.shape) >= cfg.min_visible:
             candidates.append(self._filter_peak(frame, self._anchor, size, angle))
-        if self._lost_frames >= FRAME_SEARCH_AFTER and not (candidates and candidates[0][1] >= wanted):
+        if self._lost_frames >= FRAME_SEARCH_AFTER and not (
+            candidates and candidates[0][1] >= wanted
+        ):
             coarse, _, parts = tf.search_frame(frame, size, self._search_part)
             self._search_part = (self._search_part + 1) % parts
             candidates.append(self._filter_peak(frame, coarse, size, angle))
@@ -286,40 +441,87 @@ class IemdTracker:
         emd = CandidateModel(self._context(pyramid, angle), found, size).emd()[0]
         if self._lost_reason(emd, found, size, angle, frame.shape)[0] is not None:
             return None
-        self._center, self._size, self._angle, self._lost, self._lost_frames = found, size, angle, False, 0
+        self._center, self._size, self._angle, self._lost, self._lost_frames = (
+            found,
+            size,
+            angle,
+            False,
+            0,
+        )
         self._anchor = None
-        return TrackResult(box=_box(found, size, angle), emd=emd, iterations=0, lost=False, angle=angle,
-                           starts=starts + len(candidates), codings=codings + 1, predicted_box=predicted,
-                           cause=Cause.REDETECTED,
-                           reason=f"re-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean")
+        return TrackResult(
+            box=_box(found, size, angle),
+            emd=emd,
+            iterations=0,
+            lost=False,
+            angle=angle,
+            starts=starts + len(candidates),
+            codings=codings + 1,
+            predicted_box=predicted,
+            cause=Cause.REDETECTED,
+            reason=(
+                f're-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean'
+            ),
+        )
 
     def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float]:
-        """(where the translation filter's response peaks in the region around ``at``, its value)."""
+        """(centre, value) of the translation filter's peak in its search region around ``at``."""
         tf = self._translation_filter
         return at + tf.estimate(frame, at, size, angle), tf.response_peak
 
     def _search_all(self, frame, previous, grey, pyramid, prior, center, size, angle):
-        """(best descent, every search run, starts searched) from the prediction ``center``: the fine starts
-        (flow, translation filter, colour model) and, when the frame looks lost, section 6.1's particles."""
+        """
+        (best descent, every search run, starts searched) from the prediction ``center``.
+
+        The fine starts (flow, translation filter, colour model) and, when the frame looks lost,
+        section 6.1's particles.
+        """
         cfg = self.config
-        # Where the flow, the translation filter and the colour model take the window: independent, so the flow and
-        # the colour model run on the worker threads while the filter runs here (their kernels release the GIL).
+        # Where the flow, the translation filter and the colour model take the window: independent,
+        # so the flow and the colour model run on the worker threads while the filter runs here
+        # (their kernels release the GIL).
         self._colour_now = self._colour_model is not None and frame.ndim == 3
-        jobs = [_workers().submit(window_flow, previous, grey, _box(self._center, self._size, self._angle), prior,
-                                  cfg.flow_max_error)] if cfg.flow_start else []
-        colour = (_workers().submit(self._colour_model.estimate, frame, center, size, angle)
-                  if self._colour_now else None)
+        jobs = (
+            [
+                _workers().submit(
+                    window_flow,
+                    previous,
+                    grey,
+                    _box(self._center, self._size, self._angle),
+                    prior,
+                    cfg.flow_max_error,
+                )
+            ]
+            if cfg.flow_start
+            else []
+        )
+        colour = (
+            _workers().submit(self._colour_model.estimate, frame, center, size, angle)
+            if self._colour_now
+            else None
+        )
         if self._translation_filter is not None:
             jobs.append(self._translation_filter.estimate(frame, center, size, angle))
         jobs += [colour] if colour is not None else []
         moves = [job.result() if isinstance(job, Future) else job for job in jobs]
-        fine_starts = [center + move for move in moves if move is not None and np.linalg.norm(move) >= cfg.min_step_px]
+        fine_starts = [
+            center + move
+            for move in moves
+            if move is not None and np.linalg.norm(move) >= cfg.min_step_px
+        ]
         best = self._search(pyramid, [center, *fine_starts], size, angle, center)
         searches, starts = [best], 1 + len(fine_starts)
-        if cfg.n_particles and (self._lost or best.emd > cfg.particle_trigger * self._background_emd):
+        if cfg.n_particles and (
+            self._lost or best.emd > cfg.particle_trigger * self._background_emd
+        ):
             distance = cfg.particle_offset * (2.0 if self._lost else 1.0)
-            candidate = self._search(pyramid, center + _particle_offsets(cfg.n_particles, distance) * size, size,
-                                     angle, center)
+            candidate = self._search(
+                pyramid,
+                center + _particle_offsets(cfg.n_particles, distance) * size,
+                size,
+                angle,
+                center,
+            )
             starts += cfg.n_particles
             searches.append(candidate)
             if candidate.emd < best.emd:
@@ -327,122 +529,198 @@ class IemdTracker:
         return best, searches, starts
 
     def _estimate_scale(self, frame, best: _Descent, bounds) -> tuple[_Descent, float]:
-        """(window, relative scale) at the converged window: the scale filter's estimate, the window not solved
-        again at the new size (docs/decisions.md#scale-no-resolve), or the paper's EMD variants."""
+        """
+        (window, relative scale) at the converged window.
+
+        The scale filter's estimate, the window not solved again at the new size
+        (docs/decisions.md#scale-no-resolve), or the paper's EMD variants.
+        """
         if self._scale_filter is not None:
-            scale = self._scale_filter.estimate(frame, best.center, best.model.size, best.model.angle, bounds)
+            scale = self._scale_filter.estimate(
+                frame, best.center, best.model.size, best.model.angle, bounds
+            )
             return _Descent(model=best.model, emd=best.emd), scale
         return self._search_scale(best, bounds)
 
     def _learn(self, frame, final: _Descent, confidence, center, size, angle) -> None:
-        """Every model learns the window of a tracked frame: the response's running mean, both filters, the colour
-        histograms and the template dictionary (Algorithm 2)."""
+        """
+        Every model learns the window of a tracked frame.
+
+        The response's running mean, both filters, the colour histograms and the template
+        dictionary (Algorithm 2).
+        """
         if confidence is not None:
-            self._confidence = confidence if self._confidence is None else (
-                (1.0 - CONFIDENCE_RATE) * self._confidence + CONFIDENCE_RATE * confidence)
-        learners = [model.update for model, on in ((self._scale_filter, self._scale_filter is not None),
-                                                   (self._colour_model, self._colour_now)) if on]
-        jobs = [_workers().submit(learn, frame, center, size, angle) for learn in learners]  # independent models
+            self._confidence = (
+                confidence
+                if self._confidence is None
+                else ((1.0 - CONFIDENCE_RATE) * self._confidence + CONFIDENCE_RATE * confidence)
+            )
+        learners = [
+            model.update
+            for model, on in (
+                (self._scale_filter, self._scale_filter is not None),
+                (self._colour_model, self._colour_now),
+            )
+            if on
+        ]
+        # independent models
+        jobs = [_workers().submit(learn, frame, center, size, angle) for learn in learners]
         if self._translation_filter is not None:
             self._translation_filter.update(frame, center, size, angle)
-        if self.config.update_templates and self.dictionary.observe(final.model.template, final.emd,
-                                                                    self._frame_index):
+        if self.config.update_templates and self.dictionary.observe(
+            final.model.template, final.emd, self._frame_index
+        ):
             self._refresh_target()
         for job in jobs:
             job.result()
 
     def _context(self, pyramid: ImagePyramid, angle: float = 0.0) -> SearchContext:
-        """The search context of windows turned by ``angle`` on ``pyramid``'s frame: the current target model
-        and dictionary."""
+        """
+        Return the search context of windows turned by ``angle`` on ``pyramid``'s frame.
+
+        It holds the current target model and dictionary.
+        """
         cfg = self.config
-        return SearchContext(pyramid, self.layout, self._target, self.dictionary, cfg.alpha, cfg.kernel_bandwidth,
-                             angle=angle)
+        return SearchContext(
+            pyramid,
+            self.layout,
+            self._target,
+            self.dictionary,
+            cfg.alpha,
+            cfg.kernel_bandwidth,
+            angle=angle,
+        )
 
     def _take_frame(self, frame: np.ndarray):
-        """(grey levels kept from the previous frame, ``frame``'s grey levels, its pyramid).  With the flow
-        start the grey levels are kept for the next frame, copied (the caller may reuse its buffer);
-        without it nothing is kept (None)."""
+        """
+        (grey levels kept from the previous frame, ``frame``'s grey levels, its pyramid).
+
+        With the flow start the grey levels are kept for the next frame, copied (the caller may
+        reuse its buffer); without it nothing is kept (None).
+        """
         keep = self.config.flow_start
         grey = grey_levels(frame, copy=keep)
         previous, self._previous = self._previous, (grey if keep else None)
         return previous, grey, ImagePyramid(to_gray(grey))
 
     def _confidence_check(self, center) -> tuple[float | None, str]:
-        """(the translation filter's response at the window centre ``center``, why the frame is held: "" when
-        it learns).  Held: the response is below ``update_confidence`` times its running mean over the frames that
-        learned (docs/decisions.md#occlusion-check).  (None, "") without the filter or the check."""
+        """
+        Return (the filter's response at the window centre ``center``, why the frame is held).
+
+        The filter is the translation filter; the reason is "" when the frame learns.  Held: the
+        response is below ``update_confidence`` times its running mean over the frames that learned
+        (docs/decisions.md#occlusion-check).  (None, "") without the filter or the check.
+        """
         threshold = self.config.update_confidence
         if self._translation_filter is None or threshold == 0:
-            return None, ""
+            return None, ''
         confidence = self._translation_filter.response_at(center)
         if self._confidence is None or confidence >= threshold * self._confidence:
-            return confidence, ""
-        return confidence, (f"models not updated: filter response {confidence:.3f} < {threshold} x its running mean "
-                            f"{self._confidence:.3f} (occlusion?)")
+            return confidence, ''
+        return confidence, (
+            f'models not updated: filter response {confidence:.3f} < {threshold} x its running '
+            f'mean {self._confidence:.3f} (occlusion?)'
+        )
 
-    def _lost_reason(self, emd: float, center, size, angle: float, shape) -> tuple[Cause | None, str]:
-        """(cause, reason) when the window (``center``, ``size``, ``angle``) of EMD ``emd`` counts as lost, else
-        (None, "")."""
+    def _lost_reason(
+        self, emd: float, center, size, angle: float, shape
+    ) -> tuple[Cause | None, str]:
+        """
+        (cause, reason) when the window (``center``, ``size``, ``angle``) counts as lost.
+
+        ``emd`` is the window's EMD; (None, "") when the window does not count as lost.
+        """
         cfg = self.config
         visible = _visible_fraction(center, size, angle, shape)
         if visible < cfg.min_visible:
-            return Cause.OUT_OF_VIEW, f"only {visible:.0%} of the window is inside the image"
+            return Cause.OUT_OF_VIEW, f'only {visible:.0%} of the window is inside the image'
         if not np.isfinite(emd) or emd > cfg.lost_factor * self._background_emd:
-            return (Cause.EMD_ABOVE_BACKGROUND,
-                    f"EMD {emd:.4f} > {cfg.lost_factor} x background EMD {self._background_emd:.4f}")
-        return None, ""
+            return (
+                Cause.EMD_ABOVE_BACKGROUND,
+                f'EMD {emd:.4f} > {cfg.lost_factor} x background EMD {self._background_emd:.4f}',
+            )
+        return None, ''
 
     def _measure_background_emd(self, pyramid: ImagePyramid) -> float:
-        """Median EMD between the target and the four windows one window size away in I_0: the reference for
-        "this no longer looks like the target" of the particles and the lost state
-        (docs/decisions.md#background-emd)."""
+        """
+        Median EMD between the target and the four windows one window size away in I_0.
+
+        The reference for "this no longer looks like the target" of the particles and the lost
+        state (docs/decisions.md#background-emd).
+        """
         context = self._context(pyramid)
-        values = [CandidateModel(context, self._center + offset * self._size, self._size).emd()[0]
-                  for offset in _particle_offsets(4, 1.0)]
+        values = [
+            CandidateModel(context, self._center + offset * self._size, self._size).emd()[0]
+            for offset in _particle_offsets(4, 1.0)
+        ]
         finite = [v for v in values if np.isfinite(v)]
         return float(np.median(finite)) if finite else np.inf
 
     def _refresh_target(self) -> None:
-        """Target model of eq. (sparse target model) against the current dictionary: the appearance vectors
-        stay those of I_0, as in Algorithm 1, and are only recoded (docs/decisions.md#target-appearance)."""
+        """
+        Target model of eq. (sparse target model) against the current dictionary.
+
+        The appearance vectors stay those of I_0, as in Algorithm 1, and are only recoded
+        (docs/decisions.md#target-appearance).
+        """
         pooled = self.dictionary.code_weights(self._target_eps)
-        self._target = TargetModel.from_patches(self.layout.positions(), self._target_eps, pooled,
-                                                self.config.kernel_bandwidth)
+        self._target = TargetModel.from_patches(
+            self.layout.positions(), self._target_eps, pooled, self.config.kernel_bandwidth
+        )
 
     def _search(self, pyramid: ImagePyramid, starts, size, angle: float, prediction) -> _Descent:
-        """Algorithm 1 from the ``starts`` (centres): the start of lowest EMD is descended, and with the
-        translation filter or the colour model also the start of lowest :meth:`_score`; the descended window of
-        lowest score is kept, among those the occlusion check would not hold when there are any
-        (:meth:`_confidence_check`).  ``prediction`` is the predicted centre, from which the score's motion prior
-        measures a window's displacement.  The descent's capture range is a few pixels
-        (docs/decisions.md#capture-range): the other starts are what reach farther.
+        """
+        Algorithm 1 from the ``starts`` (centres).
+
+        The start of lowest EMD is descended, and with the translation filter or the colour model
+        also the start of lowest :meth:`_score`; the descended window of lowest score is kept,
+        among those the occlusion check would not hold when there are any
+        (:meth:`_confidence_check`).  ``prediction`` is the predicted centre, from which the
+        score's motion prior measures a window's displacement.  The descent's capture range is a
+        few pixels (docs/decisions.md#capture-range): the other starts are what reach farther.
         """
         context = self._context(pyramid, angle)
         models = [CandidateModel(context, s, size) for s in starts]
-        warnings = sum(_not_optimal(model.emd()[1]) for model in models)  # each model caches its EMD
+        # each model caches its EMD
+        warnings = sum(_not_optimal(model.emd()[1]) for model in models)
         chosen = [min(models, key=lambda model: model.emd()[0])]
         if self._discriminative:
-            checked = min(models, key=lambda model: self._score(model.emd()[0], model.center, prediction, size))
+            checked = min(
+                models,
+                key=lambda model: self._score(model.emd()[0], model.center, prediction, size),
+            )
             chosen += [checked] if checked is not chosen[0] else []
         descents = [self._descend(model) for model in chosen]
         for state in descents:
             state.confidence, state.held_reason = self._confidence_check(state.center)
         confident = [state for state in descents if not state.held_reason]
-        best = min(confident or descents, key=lambda state: self._score(state.emd, state.center, prediction, size))
+        best = min(
+            confident or descents,
+            key=lambda state: self._score(state.emd, state.center, prediction, size),
+        )
         best.codings = len(models) + sum(state.codings for state in descents)
         best.warnings = warnings + sum(state.warnings for state in descents)
         return best
 
     @property
     def _discriminative(self) -> bool:
-        """Whether this frame's score has terms besides the EMD: the translation filter's, the colour model's."""
+        """
+        Whether this frame's score has terms besides the EMD.
+
+        Those are the translation filter's and the colour model's.
+        """
         return self._translation_filter is not None or self._colour_now
 
     def _score(self, emd: float, center, prediction, size) -> float:
-        """What the search minimizes: the EMD, and with the translation filter or the colour model the EMD relative
-        to the background EMD less ``translation_weight`` times the filter's response and ``colour_weight`` times
-        the colour model's mean at the window centre ``center``, plus ``motion_weight`` times the squared
-        displacement from ``prediction`` over the window's area (``size`` (w, h))."""
+        """
+        Return what the search minimizes.
+
+        The EMD, and with the translation filter or the colour model the EMD relative to the
+        background EMD less ``translation_weight`` times the filter's response and
+        ``colour_weight`` times the colour model's mean at the window centre ``center``, plus
+        ``motion_weight`` times the squared displacement from ``prediction`` over the window's area
+        (``size`` (w, h)).
+        """
         if not self._discriminative:
             return emd
         background = self._background_emd if np.isfinite(self._background_emd) else 1.0
@@ -452,20 +730,24 @@ class IemdTracker:
         if self._colour_now:
             score -= self.config.colour_weight * self._colour_model.score_at(center)
         displacement = np.asarray(center, dtype=np.float64) - prediction
-        return score + self.config.motion_weight * float(displacement @ displacement) / float(size[0] * size[1])
+        return score + self.config.motion_weight * float(displacement @ displacement) / float(
+            size[0] * size[1]
+        )
 
     def _descend(self, model: CandidateModel) -> _Descent:
-        """Algorithm 1 from the window of ``model``: move against dEMD/dy while the EMD decreases.
+        """
+        Algorithm 1 from the window of ``model``: move against dEMD/dy while the EMD decreases.
 
-        The first step is ``step_px``, halved on an increase until it falls below ``min_step_px``: the paper's
-        stopping rule (the EMD no longer decreases at the finest step) with sub-pixel moves
-        (docs/decisions.md#descent-step).
+        The first step is ``step_px``, halved on an increase until it falls below ``min_step_px``:
+        the paper's stopping rule (the EMD no longer decreases at the finest step) with sub-pixel
+        moves (docs/decisions.md#descent-step).
         """
         cfg = self.config
         half = model.size / 2.0
         axes = window_axes(model.angle)
         emd, grad, _ = model.evaluate(cfg.gradient)  # cached for _search's winners
-        state = _Descent(model=model, emd=emd)  # its solve is counted by the caller, with its coding
+        # its solve is counted by the caller, with its coding
+        state = _Descent(model=model, emd=emd)
         step, min_step = cfg.step_px, cfg.min_step_px
         while state.iterations < cfg.n_iter and step >= min_step:
             g_px = axes @ (grad / half)  # gradient with respect to image pixels
@@ -483,12 +765,17 @@ class IemdTracker:
                 step *= 0.5
         return state
 
-    def _search_scale(self, state: _Descent, bounds: tuple[float, float]) -> tuple[_Descent, float]:
-        """The paper's scale variants at the converged centre (section 6.1: the window enlarged and shrunk by
-        ``scale_step``), stepping on in each direction while the EMD decreases, up to ``scale_range``, never
-        leaving ``bounds`` (:func:`_scale_bounds`).  Each variant is the window resampled at s * size, so its
-        patch layout is the target's and its EMD compares with the EMD at scale 1.  Returns the chosen window
-        (its ``codings`` and ``warnings`` those of the variants) and its relative scale.
+    def _search_scale(
+        self, state: _Descent, bounds: tuple[float, float]
+    ) -> tuple[_Descent, float]:
+        """
+        Search the paper's scale variants at the converged centre (section 6.1).
+
+        The window is enlarged and shrunk by ``scale_step``, stepping on in each direction while
+        the EMD decreases, up to ``scale_range``, never leaving ``bounds`` (:func:`_scale_bounds`).
+        Each variant is the window resampled at s * size, so its patch layout is the target's and
+        its EMD compares with the EMD at scale 1.  Returns the chosen window (its ``codings`` and
+        ``warnings`` those of the variants) and its relative scale.
         """
         cfg = self.config
         chosen = _Descent(model=state.model, emd=state.emd)
@@ -512,8 +799,11 @@ class IemdTracker:
 
 
 def warm_up() -> None:
-    """Compile the tracker's numba kernels now (or load them from numba's on-disk cache), so that the first
-    frames of a node or a replay are not spent compiling."""
+    """
+    Compile the tracker's numba kernels now (or load them from numba's on-disk cache).
+
+    Then the first frames of a node or a replay are not spent compiling.
+    """
     frame = (np.random.default_rng(0).random((64, 64)) * 255).astype(np.uint8)
     tracker = IemdTracker()
     tracker.init(frame, (16, 16, 32, 32))
@@ -523,8 +813,12 @@ def warm_up() -> None:
 # ---------------------------------------------------------------- helpers
 @functools.cache
 def _workers() -> ThreadPoolExecutor:
-    """The threads the models of one frame run on side by side, shared by every tracker of the process."""
-    return ThreadPoolExecutor(max_workers=WORKERS, thread_name_prefix="iemd-tracker")
+    """
+    Return the threads the models of one frame run on side by side.
+
+    They are shared by every tracker of the process.
+    """
+    return ThreadPoolExecutor(max_workers=WORKERS, thread_name_prefix='iemd-tracker')
 
 
 def _box(center, size, angle: float = 0.0):
@@ -535,17 +829,24 @@ def _box(center, size, angle: float = 0.0):
 
 
 def _scale_bounds(size, shape) -> tuple[float, float]:
-    """(lowest, highest) relative scale of the window of ``size`` (w, h): its shorter side stays at least
-    MIN_SIDE_PX and its area at most the image's (``shape``), DSST's bounds on the scale factor, by area so that
-    they hold for a turned window too.  A window already outside them may not move further out
-    (docs/decisions.md#scale-bounds)."""
+    """
+    (lowest, highest) relative scale of the window of ``size`` (w, h).
+
+    Its shorter side stays at least MIN_SIDE_PX and its area at most the image's (``shape``),
+    DSST's bounds on the scale factor, by area so that they hold for a turned window too.  A window
+    already outside them may not move further out (docs/decisions.md#scale-bounds).
+    """
     lower = MIN_SIDE_PX / float(min(size))
     upper = float(np.sqrt(shape[0] * shape[1] / (size[0] * size[1])))
     return min(lower, 1.0), max(upper, 1.0)
 
 
 def _not_optimal(solution) -> int:
-    """1 if an EMD solve ended without an optimal flow (counted in TrackResult.solver_warnings), else 0."""
+    """
+    1 if an EMD solve ended without an optimal flow, else 0.
+
+    Counted in TrackResult.solver_warnings.
+    """
     return int(solution is not None and not solution.optimal)
 
 
@@ -554,19 +855,22 @@ def _wrap_angle(angle: float) -> float:
 
 
 def _particle_offsets(n: int, distance: float) -> np.ndarray:
-    """n starting offsets (in window sizes) evenly around the prediction."""
+    """Return n starting offsets (in window sizes) evenly around the prediction."""
     angles = 2.0 * np.pi * np.arange(n) / max(n, 1)
     return distance * np.column_stack([np.cos(angles), np.sin(angles)])
 
 
 def _visible_fraction(center, size, angle: float, shape) -> float:
-    """Share of the window's area inside the image, the window turned by ``angle`` about its centre.
+    """
+    Share of the window's area inside the image, the window turned by ``angle`` about its centre.
 
     In pixel-edge coordinates the image spans [0, W] x [0, H] and the window is
     centred at ``center + 0.5`` (pixel centres at integers, as ``centre_box``).
     """
     h_img, w_img = shape[:2]
-    corners = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]) * (np.asarray(size) / 2.0)
+    corners = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]) * (
+        np.asarray(size) / 2.0
+    )
     window = corners @ window_axes(angle).T + np.asarray(center) + 0.5
     image = np.array([[0.0, 0.0], [w_img, 0.0], [w_img, h_img], [0.0, h_img]], dtype=np.float32)
     area = cv2.intersectConvexConvex(window.astype(np.float32), image)[0]
@@ -574,8 +878,11 @@ def _visible_fraction(center, size, angle: float, shape) -> float:
 
 
 def _apply_prior(H: np.ndarray, center, size):
-    """Move the window by the homography: centre mapped, size scaled by sqrt|det J| of H there,
-    and the turn (radians) of J's rotation part, which the window's orientation follows.
+    """
+    Move the window by the homography.
+
+    Returns the centre mapped, the size scaled by sqrt|det J| of H there, and the turn (radians) of
+    J's rotation part, which the window's orientation follows.
 
     The turn is what keeps a camera roll from misaligning the window with the
     target (the CMU desk sequence rolls the eagle's head by up to 180 degrees).
@@ -586,44 +893,50 @@ def _apply_prior(H: np.ndarray, center, size):
     J = (H[:2, :2] - np.outer(new_center, H[2, :2])) / p[2]
     scale = float(np.sqrt(abs(np.linalg.det(J))))
     if not np.all(np.isfinite(new_center)) or not np.isfinite(scale) or scale <= 0:
-        raise ValueError("prior homography maps the target centre to infinity")
+        raise ValueError('prior homography maps the target centre to infinity')
     turn = float(np.arctan2(J[1, 0] - J[0, 1], J[0, 0] + J[1, 1]))
     return new_center, size * scale, turn
 
 
 def _is_colour(frame: np.ndarray) -> bool:
-    """Whether ``frame`` has colour: three channels that are not all equal (grey sequences are often stored as
-    BGR images with three equal channels)."""
-    return frame.ndim == 3 and not (np.array_equal(frame[..., 0], frame[..., 1])
-                                    and np.array_equal(frame[..., 1], frame[..., 2]))
+    """
+    Whether ``frame`` has colour.
+
+    Colour: three channels that are not all equal (grey sequences are often stored as BGR images
+    with three equal channels).
+    """
+    return frame.ndim == 3 and not (
+        np.array_equal(frame[..., 0], frame[..., 1])
+        and np.array_equal(frame[..., 1], frame[..., 2])
+    )
 
 
 def _check_frame(frame) -> None:
     if not isinstance(frame, np.ndarray):
-        raise ValueError(f"frame must be a numpy array, got {type(frame).__name__}")
+        raise ValueError(f'frame must be a numpy array, got {type(frame).__name__}')
     if frame.dtype != np.uint8:
-        raise ValueError(f"frame must be uint8, got {frame.dtype}")
+        raise ValueError(f'frame must be uint8, got {frame.dtype}')
     if frame.ndim not in (2, 3) or (frame.ndim == 3 and frame.shape[2] != 3):
-        raise ValueError(f"frame must be HxW or HxWx3 (BGR), got shape {frame.shape}")
+        raise ValueError(f'frame must be HxW or HxWx3 (BGR), got shape {frame.shape}')
     if frame.shape[0] < 2 or frame.shape[1] < 2:
-        raise ValueError(f"frame is empty (shape {frame.shape})")
+        raise ValueError(f'frame is empty (shape {frame.shape})')
 
 
 def _check_box(box, shape):
     x, y, w, h = check_box(box)
     if x + w <= 0 or y + h <= 0 or x >= shape[1] or y >= shape[0]:
-        raise ValueError(f"box {box!r} lies outside the {shape[1]}x{shape[0]} image")
-    TARGET_SIDE.check("box w", w, shape[1])
-    TARGET_SIDE.check("box h", h, shape[0])
+        raise ValueError(f'box {box!r} lies outside the {shape[1]}x{shape[0]} image')
+    TARGET_SIDE.check('box w', w, shape[1])
+    TARGET_SIDE.check('box h', h, shape[0])
     return x, y, w, h
 
 
 def _check_prior(prior) -> np.ndarray:
     H = np.asarray(prior, dtype=np.float64)
     if H.shape != (3, 3):
-        raise ValueError(f"prior must be a 3x3 homography, got shape {H.shape}")
+        raise ValueError(f'prior must be a 3x3 homography, got shape {H.shape}')
     if not np.all(np.isfinite(H)):
-        raise ValueError("prior homography has non-finite values")
+        raise ValueError('prior homography has non-finite values')
     if abs(np.linalg.det(H)) < 1e-12:
-        raise ValueError("prior homography is singular")
+        raise ValueError('prior homography is singular')
     return H

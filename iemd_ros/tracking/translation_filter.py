@@ -1,38 +1,78 @@
-"""Discriminative evidence of the window's position: a spatial-temporal regularized correlation filter (STRCF).
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
 
-The iEMD histograms are a generative model with no notion of background: where the target turns or is partly
-hidden, a window on background or on a similar object can score an EMD as low as the target's.  A correlation
-filter trained on the target against its own surroundings is the complementary view (docs/decisions.md#strcf).
+"""
+Discriminative evidence of the window's position.
 
-* Features (:mod:`iemd_ros.tracking.features`): grey + fHOG + Colour Names on 4x4 cells (42 channels; 32 on grey
-  frames), the feature set of STRCF and AutoTrack.
-* Sample: a square region of side ``SEARCH_AREA_SCALE`` x ``sqrt(w h)`` of the target, turned with the window,
-  resampled so that its area lies in ``[150^2, 160^2]`` px (at most 40 x 40 cells); a cosine window; a Gaussian
-  label of std ``sqrt(w h) / cell / 16`` cells.
-* Filter: STRCF (Li, Tian, Zuo, Zhang, Yang, "Learning Spatial-Temporal Regularized Correlation Filters for Visual
-  Tracking", CVPR 2018).  Each learning frame minimizes (STRCF eq. 3)
-  ``E(f) = 1/(2T) ||sum_d x_d (*) f_d - y||^2 + 1/2 sum_d ||w . f_d||^2 + mu/2 sum_d ||f_d - f_{t-1,d}||^2``
-  with the binary window ``w`` of BACF (Kiani Galoogahi et al., ICCV 2017): ``1e-3`` on the target's cells,
-  ``1e5`` elsewhere, so that every circular shift of the padded sample is a real background negative.  ADMM on
-  ``f = g`` (STRCF eqs. 5-10), 2 iterations: the f-step per frequency by Sherman-Morrison (eq. 8), the g-step
-  element-wise in space (eq. 9), the multiplier update (eq. 10).  The training sample is the detection sample
+A spatial-temporal regularized correlation filter (STRCF).
+
+The iEMD histograms are a generative model with no notion of background: where the target turns or
+is partly hidden, a window on background or on a similar object can score an EMD as low as the
+target's.  A correlation filter trained on the target against its own surroundings is the
+complementary view (docs/decisions.md#strcf).
+
+* Features (:mod:`iemd_ros.tracking.features`): grey + fHOG + Colour Names on 4x4 cells (42
+  channels; 32 on grey frames), the feature set of STRCF and AutoTrack.
+* Sample: a square region of side ``SEARCH_AREA_SCALE`` x ``sqrt(w h)`` of the target, turned with
+  the window, resampled so that its area lies in ``[150^2, 160^2]`` px (at most 40 x 40 cells); a
+  cosine window; a Gaussian label of std ``sqrt(w h) / cell / 16`` cells.
+* Filter: STRCF (Li, Tian, Zuo, Zhang, Yang, "Learning Spatial-Temporal Regularized Correlation
+  Filters for Visual Tracking", CVPR 2018).  Each learning frame minimizes (STRCF eq. 3)
+  ``E(f) = 1/(2T) ||sum_d x_d (*) f_d - y||^2 + 1/2 sum_d ||w . f_d||^2
+  + mu/2 sum_d ||f_d - f_{t-1,d}||^2`` with the binary window ``w`` of BACF (Kiani Galoogahi et
+  al., ICCV 2017): ``1e-3`` on the target's cells, ``1e5`` elsewhere, so that every circular shift
+  of the padded sample is a real background negative.  ADMM on ``f = g`` (STRCF eqs. 5-10), 2
+  iterations: the f-step per frequency by Sherman-Morrison (eq. 8), the g-step element-wise in
+  space (eq. 9), the multiplier update (eq. 10).  The training sample is the detection sample
   circularly shifted to the new centre in the Fourier domain (AutoTrack's ``shift_sample``).
-* Detection: the response ``r = F^-1(sum_d conj(f_d^) z_d^)`` on the cell grid, its peak refined by Newton's method
-  on the Fourier interpolant (SRDCF); :meth:`TranslationFilter.response_at` reads it at any window centre.
+* Detection: the response ``r = F^-1(sum_d conj(f_d^) z_d^)`` on the cell grid, its peak refined by
+  Newton's method on the Fourier interpolant (SRDCF); :meth:`TranslationFilter.response_at` reads
+  it at any window centre.
 """
 from __future__ import annotations
 
-import cv2
+from iemd_ros.tracking import features
+from iemd_ros.tracking.appearance import window_axes
+from iemd_ros.tracking.correlation_filter import (
+    apce,
+    correlate,
+    energy,
+    gaussian_label,
+    hann_inner,
+    sample_region,
+    SubCellPeak,
+)
 import numba
 import numpy as np
 import scipy.fft as sfft
 
-from iemd_ros.tracking import features
-from iemd_ros.tracking.appearance import window_axes
-from iemd_ros.tracking.correlation_filter import (SubCellPeak, apce, correlate, energy, gaussian_label, hann_inner,
-                                                 sample_region)
-
-__all__ = ["TranslationFilter", "SEARCH_AREA_SCALE"]
+__all__ = ['TranslationFilter', 'SEARCH_AREA_SCALE']
 
 SEARCH_AREA_SCALE = 5.0                       # side of the search region / sqrt(w h) (STRCF, BACF)
 SAMPLE_AREA = (150.0 ** 2, 160.0 ** 2)        # area bounds of the resampled region, px^2
@@ -45,20 +85,23 @@ FRAME_SEARCH_CELLS = 2048  # feature cells searched per search_frame call (its c
 
 
 class TranslationFilter:
-    """STRCF over the search region around the window (see the module docstring).
+    """
+    STRCF over the search region around the window (see the module docstring).
 
-    The filter keeps no position of its own: :meth:`estimate` and :meth:`update` take the window from the caller,
-    which fuses the response with its other cues first.
+    The filter keeps no position of its own: :meth:`estimate` and :meth:`update` take the window
+    from the caller, which fuses the response with its other cues first.
     """
 
     def __init__(self):
         self.f = None
         self._detection = self._response = None
-        self._frame_filter = None  # (f, shape, its conjugate spectrum at that shape) for search_frame
+        # (f, shape, its conjugate spectrum at that shape) for search_frame
+        self._frame_filter = None
         self.response_peak = None  # the last estimate's peak value
 
     def init(self, frame: np.ndarray, center, size, colour: bool, angle: float = 0.0) -> None:
-        """Set up the sample geometry from the first window and learn the first filter (``mu = 0``).
+        """
+        Set up the sample geometry from the first window and learn the first filter (``mu = 0``).
 
         Parameters
         ----------
@@ -70,12 +113,14 @@ class TranslationFilter:
             Whether the sequence has colour (Colour Names are used on colour frames only).
         angle : float
             The window's turn (radians).
+
         """
         w, h = max(float(size[0]), 1.0), max(float(size[1]), 1.0)
         self.colour = bool(colour)
         area = w * h * SEARCH_AREA_SCALE ** 2
         s0 = np.sqrt(area / np.clip(area, *SAMPLE_AREA))
-        self.base_wh = np.array([w, h]) / s0              # the target's size in the resampled sample, px
+        # the target's size in the resampled sample, px
+        self.base_wh = np.array([w, h]) / s0
         n = max(int(round(np.sqrt(np.prod(self.base_wh)) * SEARCH_AREA_SCALE / features.CELL)), 8)
         self.map_hw = (n, n)
         self.support = float(n * features.CELL)            # the resampled sample's side, px
@@ -99,8 +144,10 @@ class TranslationFilter:
 
     # ------------------------------------------------------------------ detection
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
-        """Where the response of the current filter peaks, as a displacement (dx, dy) px from ``center``; the
-        response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
+        """
+        Displacement (dx, dy) px from ``center`` to where the current filter's response peaks.
+
+        The response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
 
         Parameters
         ----------
@@ -115,6 +162,7 @@ class TranslationFilter:
         -------
         ndarray
             (2,) displacement, image px.
+
         """
         scale = self._scale(size)
         pos = self._position(center, angle)
@@ -127,24 +175,38 @@ class TranslationFilter:
         self._detection = (id(frame), pos, scale, angle, zf)
         self._response = (resp, pos, cell_px, window_axes(angle))
         self.response_peak = value
-        return window_axes(angle) @ (np.array([dx, dy]) * cell_px) + pos - np.asarray(center, dtype=np.float64)
+        return (
+            window_axes(angle) @ (np.array([dx, dy]) * cell_px)
+            + pos
+            - np.asarray(center, dtype=np.float64)
+        )
 
     def response_at(self, point) -> float:
-        """The last :meth:`estimate`'s response at the window centre ``point`` (image px), interpolated bilinearly
-        between cells (the response is circular over the search region)."""
+        """
+        Return the last :meth:`estimate`'s response at the window centre ``point`` (image px).
+
+        It is interpolated bilinearly between cells (the response is circular over the search
+        region).
+        """
         if self._response is None:
-            raise RuntimeError("TranslationFilter.response_at() needs an estimate() first")
+            raise RuntimeError('TranslationFilter.response_at() needs an estimate() first')
         resp, pos, cell_px, axes = self._response
         d = axes.T @ (np.asarray(point, dtype=np.float64) - pos) / cell_px
         return _bilinear_circular(resp, float(d[1]), float(d[0]))
 
-    def search_frame(self, frame: np.ndarray, size, part: int = 0) -> tuple[np.ndarray, float, int]:
-        """Where in one part of ``frame`` the filter responds most, at the scale of a window of ``size``.
+    def search_frame(
+        self, frame: np.ndarray, size, part: int = 0
+    ) -> tuple[np.ndarray, float, int]:
+        """
+        Where in one part of ``frame`` the filter responds most.
+
+        The filter is taken at the scale of a window of ``size``.
 
         The frame is resampled to the filter's scale and cut into vertical strips of at most
-        ``FRAME_SEARCH_CELLS`` feature cells; the strip's features are correlated with the spatial filter,
-        zero-padded so that the correlation is linear, not circular (the strip is read with a margin of half the
-        filter on each side).  A caller scans the whole frame by asking for parts 0, 1, ... over several frames.
+        ``FRAME_SEARCH_CELLS`` feature cells; the strip's features are correlated with the spatial
+        filter, zero-padded so that the correlation is linear, not circular (the strip is read with
+        a margin of half the filter on each side).  A caller scans the whole frame by asking for
+        parts 0, 1, ... over several frames.
 
         Parameters
         ----------
@@ -160,52 +222,85 @@ class TranslationFilter:
         centre : ndarray
             (cx, cy) of the strongest response in the strip, image px (pixel centres at integers).
         response : float
-            The response there (no cosine window, so not comparable with :attr:`response_peak`: check a candidate
-            with :meth:`estimate`).
+            The response there (no cosine window, so not comparable with :attr:`response_peak`:
+            check a candidate with :meth:`estimate`).
         parts : int
             How many strips the frame has at this scale.
+
         """
         scale = self._scale(size)
         rows, cols = frame.shape[:2]
-        cells = (max(int(rows / (features.CELL * scale)), 1), max(int(cols / (features.CELL * scale)), 1))
+        cells = (
+            max(int(rows / (features.CELL * scale)), 1),
+            max(int(cols / (features.CELL * scale)), 1),
+        )
         parts = max(int(np.ceil(cells[0] * cells[1] / FRAME_SEARCH_CELLS)), 1)
         width = int(np.ceil(cells[1] / parts))
         parts = int(np.ceil(cells[1] / width))  # no empty last strip
-        n, c0 = self.map_hw[0], self.map_hw[0] // 2  # a target at cell k answers at displacement k - c0
+        # a target at cell k answers at displacement k - c0
+        n, c0 = self.map_hw[0], self.map_hw[0] // 2
         first = (part % parts) * width
         lo, hi = max(first - c0, 0), min(first + width + c0, cells[1])
         ratio = np.array([cols / (cells[1] * features.CELL), rows / (cells[0] * features.CELL)])
-        strip = sample_region(frame, ((lo + hi) * features.CELL / 2 * ratio[0] - 0.5, rows / 2 - 0.5),
-                              ((hi - lo) * features.CELL * ratio[0], rows), ((hi - lo) * features.CELL,
-                                                                            cells[0] * features.CELL))
+        strip = sample_region(
+            frame,
+            ((lo + hi) * features.CELL / 2 * ratio[0] - 0.5, rows / 2 - 0.5),
+            ((hi - lo) * features.CELL * ratio[0], rows),
+            ((hi - lo) * features.CELL, cells[0] * features.CELL),
+        )
         z = features.extract(strip, self.colour)
         shape = (cells[0] + n, hi - lo + n)
-        if self._frame_filter is None or self._frame_filter[0] is not self.f or self._frame_filter[1] != shape:
-            h = sfft.irfft2(self.f, s=self.map_hw, axes=(1, 2))  # the spatial filter, the target at the centre cell
+        if (
+            self._frame_filter is None
+            or self._frame_filter[0] is not self.f
+            or self._frame_filter[1] != shape
+        ):
+            # the spatial filter, the target at the centre cell
+            h = sfft.irfft2(self.f, s=self.map_hw, axes=(1, 2))
             self._frame_filter = (self.f, shape, np.conj(sfft.rfft2(h, s=shape, axes=(1, 2))))
         resp_f = np.sum(self._frame_filter[2] * sfft.rfft2(z, s=shape, axes=(1, 2)), axis=0)
-        resp = np.roll(sfft.irfft2(resp_f, s=shape), (c0, c0), axis=(0, 1))[:cells[0], first - lo:first - lo + width]
+        resp = np.roll(sfft.irfft2(resp_f, s=shape), (c0, c0), axis=(0, 1))[
+            :cells[0], first - lo:first - lo + width
+        ]
         k = np.unravel_index(int(np.argmax(resp)), resp.shape)
-        centre = (np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5) * features.CELL * ratio - 0.5
+        centre = (
+            np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5
+        ) * features.CELL * ratio - 0.5
         return centre, float(resp[k]), parts
 
     @property
     def confidence(self) -> dict:
-        """The last estimate's peak value and APCE (LMCF's average peak-to-correlation energy), computed when asked;
-        {} before any estimate."""
+        """
+        Return the last estimate's peak value and APCE (LMCF's average peak-to-correlation energy).
+
+        Computed when asked; {} before any estimate.
+        """
         if self._response is None:
             return {}
-        return {"peak": self.response_peak, "apce": apce(self._response[0])}
+        return {'peak': self.response_peak, 'apce': apce(self._response[0])}
 
     # ------------------------------------------------------------------ learning
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
-        """Learn on the window (``center``, ``size``, ``angle``) of ``frame``: the detection sample shifted there
-        when ``frame`` is the one just estimated on at this scale and turn, else a new sample (STRCF, eqs. 3-10)."""
+        """
+        Learn on the window (``center``, ``size``, ``angle``) of ``frame``.
+
+        The detection sample shifted there when ``frame`` is the one just estimated on at this
+        scale and turn, else a new sample (STRCF, eqs. 3-10).
+        """
         scale = self._scale(size)
         det, self._detection = self._detection, None
-        if det is not None and det[0] == id(frame) and abs(det[2] / scale - 1.0) < 0.05 and det[3] == angle:
+        if (
+            det is not None
+            and det[0] == id(frame)
+            and abs(det[2] / scale - 1.0) < 0.05
+            and det[3] == angle
+        ):
             _, pos, det_scale, _, zf = det
-            shift = window_axes(angle).T @ (np.asarray(center, dtype=np.float64) - pos) / (features.CELL * det_scale)
+            shift = (
+                window_axes(angle).T
+                @ (np.asarray(center, dtype=np.float64) - pos)
+                / (features.CELL * det_scale)
+            )
             phase_y = np.exp(2j * np.pi * self.ky * shift[1] / self.map_hw[0]).astype(np.complex64)
             phase_x = np.exp(2j * np.pi * self.kx * shift[0] / self.map_hw[1]).astype(np.complex64)
             xf = zf * (phase_y[:, None] * phase_x[None, :])[None]
@@ -213,15 +308,24 @@ class TranslationFilter:
             xf = self._spectrum(frame, self._position(center, angle), scale, angle)
         self.f = self._admm(xf, self.f)
 
-    def _admm(self, xf: np.ndarray, f_prev, iterations: int = ADMM_ITERATIONS,
-              gamma: tuple = (GAMMA_INIT, GAMMA_STEP, GAMMA_MAX), mu: float = MU):
-        """STRCF's ADMM (eqs. 5-10) on one sample spectrum ``xf`` (C, rows, cols//2+1), from ``g = h = 0``.
+    def _admm(
+        self,
+        xf: np.ndarray,
+        f_prev,
+        iterations: int = ADMM_ITERATIONS,
+        gamma: tuple = (GAMMA_INIT, GAMMA_STEP, GAMMA_MAX),
+        mu: float = MU,
+    ):
+        """
+        Run STRCF's ADMM (eqs. 5-10) on one sample spectrum ``xf``, from ``g = h = 0``.
 
-        Per iteration with penalty ``gamma`` (``gamma <- min(step gamma, max)``): the f-step (eq. 8)
-        ``f^ = q + x^ (conj(y^) - x^H q) / (T (gamma + mu) + x^H x^)``, ``q = (gamma g^ - h^ + mu f^_{t-1}) /
-        (gamma + mu)``; the g-step (eq. 9) ``g = (gamma f + h) / (w^2 + gamma)``; the multiplier (eq. 10)
-        ``h^ += gamma (f^ - g^)``.  The last iteration stops after its f-step, so 2 iterations cost one inverse and
-        one forward FFT.  ``mu`` is 0 on the first frame (no previous filter ``f_prev``).
+        ``xf`` is (C, rows, cols//2+1).  Per iteration with penalty ``gamma``
+        (``gamma <- min(step gamma, max)``): the f-step (eq. 8)
+        ``f^ = q + x^ (conj(y^) - x^H q) / (T (gamma + mu) + x^H x^)``,
+        ``q = (gamma g^ - h^ + mu f^_{t-1}) / (gamma + mu)``; the g-step (eq. 9)
+        ``g = (gamma f + h) / (w^2 + gamma)``; the multiplier (eq. 10) ``h^ += gamma (f^ - g^)``.
+        The last iteration stops after its f-step, so 2 iterations cost one inverse and one forward
+        FFT.  ``mu`` is 0 on the first frame (no previous filter ``f_prev``).
         """
         mu = 0.0 if f_prev is None else mu
         g_now, g_step, g_max = gamma
@@ -237,9 +341,20 @@ class TranslationFilter:
         for it in range(iterations):
             kap = g_now + mu
             dinv = (1.0 / (self.T * kap + S)).astype(rdt)
-            _f_step(xf, yfc, dinv, zeros if g is None else g, zeros if h is None else h,
-                    zeros if f_prev is None else f_prev, rdt(0.0 if g is None else g_now / kap),
-                    rdt(0.0 if h is None else 1.0 / kap), rdt(mu / kap), g is not None or h is not None or mu > 0, f, xq)
+            _f_step(
+                xf,
+                yfc,
+                dinv,
+                zeros if g is None else g,
+                zeros if h is None else h,
+                zeros if f_prev is None else f_prev,
+                rdt(0.0 if g is None else g_now / kap),
+                rdt(0.0 if h is None else 1.0 / kap),
+                rdt(mu / kap),
+                g is not None or h is not None or mu > 0,
+                f,
+                xq,
+            )
             if it == iterations - 1:
                 break
             a = g_now * f + (zeros if h is None else h)
@@ -252,14 +367,22 @@ class TranslationFilter:
 
     # ------------------------------------------------------------------ sampling
     def _scale(self, size) -> float:
-        """Image px per sample px for a window of ``size``: ``sqrt(w h)`` over the first window's, after
-        resampling (the region keeps its square shape)."""
+        """
+        Image px per sample px for a window of ``size``.
+
+        ``sqrt(w h)`` over the first window's, after resampling (the region keeps its square
+        shape).
+        """
         return float(np.sqrt(float(size[0]) * float(size[1]) / float(np.prod(self.base_wh))))
 
     @staticmethod
     def _position(center, angle: float) -> np.ndarray:
-        """Where the region is centred: the window centre, rounded to a pixel when the region is not turned
-        (STRCF's integer sample position, then the crop is exact)."""
+        """
+        Where the region is centred.
+
+        The window centre, rounded to a pixel when the region is not turned (STRCF's integer sample
+        position, then the crop is exact).
+        """
         c = np.asarray(center, dtype=np.float64)
         return np.round(c) if angle == 0.0 else c
 
@@ -277,13 +400,19 @@ def _bilinear_circular(resp: np.ndarray, y: float, x: float) -> float:
     fy, fx = y - y0, x - x0
     y0, x0 = y0 % rows, x0 % cols
     y1, x1 = (y0 + 1) % rows, (x0 + 1) % cols
-    return float((1 - fy) * ((1 - fx) * resp[y0, x0] + fx * resp[y0, x1])
-                 + fy * ((1 - fx) * resp[y1, x0] + fx * resp[y1, x1]))
+    return float(
+        (1 - fy) * ((1 - fx) * resp[y0, x0] + fx * resp[y0, x1])
+        + fy * ((1 - fx) * resp[y1, x0] + fx * resp[y1, x1])
+    )
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _f_step(xf, yfc, dinv, g, h, fp, cg, ch, cp, use_q, out, xq):
-    """STRCF's f-step (eq. 8) per frequency: ``q = cg g - ch h + cp fp``, ``f = q + x (conj(y) - x^H q) dinv``."""
+    """
+    Compute STRCF's f-step (eq. 8) per frequency.
+
+    ``q = cg g - ch h + cp fp``, ``f = q + x (conj(y) - x^H q) dinv``.
+    """
     C, H, W = xf.shape
     if not use_q:
         for d in range(C):
