@@ -73,7 +73,7 @@ def run(rec, start: int, stop: int, use_gyro: bool, config: TrackerConfig):
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
     ap.add_argument('--imu-root', type=Path, default=DEFAULT_ROOT)
     ap.add_argument(
         '--frames', type=int, default=0, help='track only this many frames (0: whole sequence)'

@@ -139,7 +139,7 @@ def run(name: str, root: Path, fraction: float, scan_ms: list[float]) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
     ap.add_argument('--imu-root', type=Path, default=DEFAULT_ROOT, help='folder of the recordings')
     ap.add_argument(
         '--fraction', type=float, default=0.10, help='fastest fraction of frame pairs (0-1]'

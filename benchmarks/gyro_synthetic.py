@@ -96,7 +96,7 @@ def row(label: str, e: np.ndarray) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
     ap.add_argument('--rate', type=float, default=200.0, help='peak angular rate, deg/s')
     ap.add_argument('--frames', type=int, default=300)
     ap.add_argument('--seed', type=int, default=11)

@@ -158,7 +158,7 @@ def desk(root: Path) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
     ap.add_argument('--imu-root', type=Path, default=DEFAULT_ROOT)
     ap.add_argument('--rate', type=float, default=257.0, help='rate / peak rate in deg/s')
     args = ap.parse_args(argv)

@@ -315,13 +315,19 @@ def _run(args, seq, setup: str, subject: str) -> dict:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--frames', type=int, default=150)
-    ap.add_argument('--rate', type=float, default=30.0)
-    ap.add_argument('--width', type=int, default=640)
-    ap.add_argument('--height', type=int, default=480)
-    ap.add_argument('--setups', default='inproc,process,process-shm,process-jpeg')
-    ap.add_argument('--subjects', default='echo,tracker')
+    ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
+    ap.add_argument('--frames', type=int, default=150, help='frames published per measurement')
+    ap.add_argument('--rate', type=float, default=30.0, help='input rate, Hz')
+    ap.add_argument('--width', type=int, default=640, help='frame width, px')
+    ap.add_argument('--height', type=int, default=480, help='frame height, px')
+    ap.add_argument(
+        '--setups',
+        default='inproc,process,process-shm,process-jpeg',
+        help='comma-separated: inproc, process, process-shm, process-jpeg',
+    )
+    ap.add_argument(
+        '--subjects', default='echo,tracker', help='comma-separated: echo (the reference), tracker'
+    )
     ap.add_argument(
         '--targets', type=int, default=1, choices=(1, 2, 3), help='targets the tracker follows'
     )

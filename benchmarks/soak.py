@@ -81,15 +81,15 @@ def slope_mb_per_hour(t_s, rss) -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('--minutes', type=float, default=30.0)
-    ap.add_argument('--rate', type=float, default=30.0)
-    ap.add_argument('--width', type=int, default=640)
-    ap.add_argument('--height', type=int, default=480)
+    ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
+    ap.add_argument('--minutes', type=float, default=30.0, help='length of the soak, min')
+    ap.add_argument('--rate', type=float, default=30.0, help='input rate, Hz')
+    ap.add_argument('--width', type=int, default=640, help='frame width, px')
+    ap.add_argument('--height', type=int, default=480, help='frame height, px')
     ap.add_argument(
         '--frames', type=int, default=150, help='frames of the sequence played over and over'
     )
-    ap.add_argument('--sample-s', type=float, default=10.0)
+    ap.add_argument('--sample-s', type=float, default=10.0, help='interval between samples, s')
     ap.add_argument('--log', default=None, help="file for the tracker's log (default: discarded)")
     ap.add_argument(
         '--default-transport',

@@ -176,7 +176,9 @@ def _replay_run(bag: Path, init: str) -> float:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
-    ap.add_argument('--runs', type=int, default=3)
+    ap.add_argument(
+        '--runs', type=int, default=3, help='runs with the cache empty, and as many with it full'
+    )
     a = ap.parse_args(argv)
     os.environ.setdefault('ROS_DOMAIN_ID', str(np.random.default_rng().integers(30, 100)))
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
