@@ -335,7 +335,7 @@ def test_the_node_keeps_answering_after_a_burst_of_hostile_inputs(ctx, seq):
 
 def test_sigterm_in_the_middle_of_a_wait_set_is_a_clean_stop(monkeypatch):
     """
-    SIGTERM during a 60 Hz burst exited 1 in 1 of 10 runs.
+    SIGTERM in the middle of a wait set stops the node cleanly (docs/decisions.md#node-soak).
 
     RCLError "failed to initialize wait set: the given context is not valid" out of rclpy.spin.
     The race, made certain: the context goes while spin is in a wait.

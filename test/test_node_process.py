@@ -199,7 +199,7 @@ def test_installed_executable_tracks_over_dds_and_stops_on_sigint(executable, st
 @pytest.mark.parametrize('signal_name', ['SIGTERM', 'SIGINT'])
 def test_a_signal_during_a_60hz_burst_exits_0_without_a_traceback(executable, signal_name):
     """
-    SIGTERM during a 60 Hz burst exited 1 with a traceback in 1 of 10 runs (issue #28).
+    A signal during a 60 Hz burst: exit 0, no traceback (docs/decisions.md#node-soak).
 
     Three runs per signal, each stopped at another moment of the burst, the signal sent again 50 ms
     later (a second Ctrl-C, or launch's SIGTERM after its SIGINT) while the node is being taken

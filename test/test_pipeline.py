@@ -542,8 +542,8 @@ def test_the_camera_turns_away_and_back_the_target_is_found_again(use_gyro):
 
     With the gyro the lost window's place follows the turn to within 2 % of the image width of the
     target's true image while it is out of view, and the target is tracked again within 5 frames of
-    its return; without the gyro the re-detection alone finds it within 30 frames (measured: back
-    on the first frame of its return either way, place error 0.0 %).
+    its return; without the gyro the re-detection alone finds it within 30 frames
+    (docs/decisions.md#re-detection).
     """
     seq = generate(motion='turn_away')
     p = _pipeline(seq, use_gyro=use_gyro)
