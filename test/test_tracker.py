@@ -28,12 +28,12 @@
 # POSSIBILITY OF SUCH DAMAGE.
 
 """IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
-from concurrent.futures import Future
 import dataclasses
 
 from helpers import rotated, shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
+from iemd_ros.common.parallel import InlineExecutor
 from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.evaluation.metrics import iou
 from iemd_ros.tracking import tracker as tracker_module
@@ -501,7 +501,7 @@ def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
     building5 (UAV123@10fps, 1280x720), frames 1-100 from the ground truth.
 
     A walking person of about 22x62 px seen from a drone that moves.  Bound: mean IoU at least 0.75
-    and no frame below 0.5 (measured: 0.84, lowest 0.66).
+    and no frame below 0.5 (docs/decisions.md#strcf).
     """
     seq = load_sequence(uav_root / 'building5')
     frames = [read_frame(path) for path in seq.frame_paths[:100]]
@@ -514,20 +514,8 @@ def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
     assert np.mean(overlaps) >= 0.75 and min(overlaps) >= 0.5, (np.mean(overlaps), min(overlaps))
 
 
-class _Inline:
-    """
-    An executor that runs each job at once on the calling thread.
-
-    It gives the tracker's serial schedule.
-    """
-
-    def submit(self, fn, *args):
-        future = Future()
-        future.set_result(fn(*args))
-        return future
-
-
 def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, monkeypatch):
+    """Woman frames 1-24: the worker threads give the boxes and EMDs of one job after another."""
     seq = load_sequence(otb_root / 'Woman')
     frames = [read_frame(p) for p in seq.frame_paths[:25]]
 
@@ -537,7 +525,7 @@ def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, mon
         return [tracker.update(frame) for frame in frames[1:]]
 
     threaded = run()
-    monkeypatch.setattr(tracker_module, '_workers', lambda: _Inline())
+    monkeypatch.setattr(tracker_module, '_workers', InlineExecutor)
     serial = run()
     assert [r.box for r in threaded] == [r.box for r in serial]
     assert [r.emd for r in threaded] == [r.emd for r in serial]

@@ -43,7 +43,7 @@ lost.
 """
 from __future__ import annotations
 
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 import enum
 import functools
@@ -73,7 +73,7 @@ __all__ = ['IemdTracker', 'TrackResult', 'Cause', 'warm_up']
 MIN_SIDE_PX = 4.0
 # learning rate of the running mean that update_confidence compares the response with
 CONFIDENCE_RATE = 0.1
-WORKERS = 2  # threads the independent models of a frame run on (this machine class: 2 cores)
+WORKERS = 2  # threads the independent models of a frame run on, beside the caller's
 # lost frames searched only around the prediction before the whole frame is searched too
 FRAME_SEARCH_AFTER = 5
 
@@ -478,32 +478,21 @@ class IemdTracker:
         """
         cfg = self.config
         # Where the flow, the translation filter and the colour model take the window: independent,
-        # so the flow and the colour model run on the worker threads while the filter runs here
-        # (their kernels release the GIL).
+        # so the flow and the colour model run on the worker threads while the filter runs here.
         self._colour_now = self._colour_model is not None and frame.ndim == 3
-        jobs = (
-            [
-                _workers().submit(
-                    window_flow,
-                    previous,
-                    grey,
-                    _box(self._center, self._size, self._angle),
-                    prior,
-                    cfg.flow_max_error,
-                )
-            ]
-            if cfg.flow_start
-            else []
-        )
-        colour = (
-            _workers().submit(self._colour_model.estimate, frame, center, size, angle)
-            if self._colour_now
-            else None
-        )
-        if self._translation_filter is not None:
-            jobs.append(self._translation_filter.estimate(frame, center, size, angle))
-        jobs += [colour] if colour is not None else []
-        moves = [job.result() if isinstance(job, Future) else job for job in jobs]
+        pool = _workers()
+        flow = colour = None
+        if cfg.flow_start:
+            box = _box(self._center, self._size, self._angle)
+            flow = pool.submit(window_flow, previous, grey, box, prior, cfg.flow_max_error)
+        if self._colour_now:
+            colour = pool.submit(self._colour_model.estimate, frame, center, size, angle)
+        tf = self._translation_filter
+        moves = [
+            flow.result() if flow else None,
+            tf.estimate(frame, center, size, angle) if tf is not None else None,
+            colour.result() if colour else None,
+        ]
         fine_starts = [
             center + move
             for move in moves
@@ -555,16 +544,12 @@ class IemdTracker:
                 if self._confidence is None
                 else ((1.0 - CONFIDENCE_RATE) * self._confidence + CONFIDENCE_RATE * confidence)
             )
-        learners = [
-            model.update
-            for model, on in (
-                (self._scale_filter, self._scale_filter is not None),
-                (self._colour_model, self._colour_now),
-            )
-            if on
-        ]
-        # independent models
-        jobs = [_workers().submit(learn, frame, center, size, angle) for learn in learners]
+        # The scale filter and the colour model learn on the worker threads beside the filter.
+        pool, jobs = _workers(), []
+        if self._scale_filter is not None:
+            jobs.append(pool.submit(self._scale_filter.update, frame, center, size, angle))
+        if self._colour_now:
+            jobs.append(pool.submit(self._colour_model.update, frame, center, size, angle))
         if self._translation_filter is not None:
             self._translation_filter.update(frame, center, size, angle)
         if self.config.update_templates and self.dictionary.observe(
