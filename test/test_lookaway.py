@@ -41,6 +41,7 @@ from iemd_ros.apps.make_lookaway import main as make_main
 from iemd_ros.datasets.lookaway import look_away_windows, LookAway, write_look_away
 from iemd_ros.datasets.otb import load_sequence, Sequence
 from iemd_ros.evaluation.metrics import long_term_scores, REACQUIRE_WITHIN
+from iemd_ros.evaluation.split import in_part
 from iemd_ros.tracking import IemdTracker
 import numpy as np
 import pytest
@@ -74,11 +75,11 @@ def test_long_term_scores_by_hand():
         long_term_scores(pred[:5], reported, gt)
 
 
-def _moving_target_sequence(tmp_path: Path, n: int = 90) -> Sequence:
+def _moving_target_sequence(tmp_path: Path, n: int = 90, name: str = 'Mover') -> Sequence:
     """Return a 16x12 bright square moving 2 px per frame to the right over a 320x240 scene."""
     rng = np.random.default_rng(0)
     scene = cv2.GaussianBlur(rng.integers(0, 255, (240, 320, 3), dtype=np.uint8), (0, 0), 3)
-    folder = tmp_path / 'src' / 'Mover'
+    folder = tmp_path / 'src' / name
     (folder / 'img').mkdir(parents=True)
     boxes = []
     for k in range(n):
@@ -177,3 +178,41 @@ def test_the_tracker_says_lost_while_a_real_target_is_away_and_finds_it_on_retur
     assert absent.sum() >= 25 and np.mean(np.asarray(ok)[absent]) <= 0.1
     assert scores.reacquired == scores.returns == 1, scores
     assert scores.f_score >= 0.6, scores
+
+
+def test_several_follow_lengths_give_one_cut_each_that_the_split_selects_by_source(
+    tmp_path, capsys
+):
+    """
+    ``--follow 10,25``: two cuts of each source, named <source>-follow<N>, looking away after N.
+
+    ``iemd-eval --split`` keeps the cuts of the part's sources: a source named Car4 is in the
+    training part, so both cuts are evaluated with it and none with the validation part.
+    """
+    seq = _moving_target_sequence(tmp_path, name='Car4')
+    args = [str(seq.frame_paths[0].parents[1]), '--out', str(tmp_path / 'la'), '--away', '20']
+    assert make_main(args + ['--follow', '10,25,10', '--pan-px', '30']) == 0
+    cuts = sorted(p.name for p in (tmp_path / 'la' / 'src').iterdir())
+    assert cuts == ['Car4-follow10', 'Car4-follow25']
+    for name, follow in zip(cuts, (10, 25)):
+        gt = load_sequence(tmp_path / 'la' / 'src' / name).gt_boxes
+        absent = np.flatnonzero(np.isnan(gt[:, 0]))
+        assert follow <= absent[0] <= follow + 10
+    root = str(tmp_path / 'la' / 'src')
+    capsys.readouterr()
+    out = ['--out', str(tmp_path / 'e')]
+    assert eval_main([root, '--trackers', 'kcf', '--split', 'train'] + out) == 0
+    doc = json.loads((tmp_path / 'e' / 'results.json').read_text())
+    assert sorted(set(doc['results']['kcf']) - {'mean'}) == cuts
+    assert eval_main([root, '--trackers', 'kcf', '--split', 'validation']) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["iemd-eval: error: the inputs hold none of the validation part's sequences"]
+    assert make_main(args + ['--follow', '10,x']) == 2
+    assert capsys.readouterr().err.count('\n') == 1
+
+
+def test_a_cut_belongs_to_the_part_of_its_source():
+    part = ['Car4', 'Jogging-1']
+    assert in_part('car4', part) and in_part('Car4-follow40', part)
+    assert in_part('Jogging-1-follow15', part)
+    assert not in_part('Jogging-2', part) and not in_part('Car44', part)

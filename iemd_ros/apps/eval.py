@@ -72,7 +72,7 @@ from iemd_ros.evaluation.ope import (
     WALL_CLOCK_FIELDS,
 )
 from iemd_ros.evaluation.published import default_published, format_published, load_published
-from iemd_ros.evaluation.split import PARTS, split_names
+from iemd_ros.evaluation.split import in_part, PARTS, split_names
 from iemd_ros.pipeline import PipelineConfig
 
 PUBLISHED_DEFAULT = Path('<default>')  # --published without a file
@@ -179,13 +179,13 @@ def main(argv: list[str] | None = None) -> int:
                     'the file'
                 )
             published = load_published(path)
-        wanted = args.sequences
+        sequences = collect_sequences(args.inputs, args.sequences)
         if args.split is not None:
+            # the part's sequences the inputs hold, and their cuts (Car4 -> Car4-follow40)
             part = split_names(args.split)
-            wanted = part if wanted is None else [w for w in wanted if w in part]
-            if not wanted:
-                raise ValueError(f"--sequences names none of the {args.split} part's sequences")
-        sequences = collect_sequences(args.inputs, wanted)
+            sequences = [s for s in sequences if in_part(s.name, part)]
+            if not sequences:
+                raise ValueError(f"the inputs hold none of the {args.split} part's sequences")
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
         workers = Workers.from_args(args)

@@ -32,7 +32,7 @@
 
 They are for the long-term measures.
 
-    iemd-make-lookaway [ROOT_OR_SEQ ...] --out DIR [--crop 0.5] [--follow 15] [--away 30]
+    iemd-make-lookaway [ROOT_OR_SEQ ...] --out DIR [--crop 0.5] [--follow 15[,40,...]] [--away 30]
                        [--pan-px 40]
 
 Without a folder it cuts every sequence of ``../shared/data/otb`` and ``../shared/data/uav`` whose
@@ -43,6 +43,7 @@ exit with status 2.
 """
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 import sys
 
@@ -71,7 +72,11 @@ def build_parser() -> CliParser:
         '--crop', type=float, default=d.crop, help=f'window size / frame size (default {d.crop})'
     )
     p.add_argument(
-        '--follow', type=int, default=d.follow_frames, help='frames followed before panning off'
+        '--follow',
+        type=_follows,
+        default=(d.follow_frames,),
+        help='frames followed before panning off; several (15,40,80): one cut of each source per '
+        f'value, named <source>-follow<N> (default {d.follow_frames})',
     )
     p.add_argument(
         '--away', type=int, default=d.away_frames, help='frames the target stays out of view'
@@ -80,21 +85,35 @@ def build_parser() -> CliParser:
     return p
 
 
+def _follows(text: str) -> tuple[int, ...]:
+    """Parse ``--follow``: the distinct positive frame counts of a comma-separated list."""
+    try:
+        values = tuple(dict.fromkeys(int(v) for v in text.split(',') if v.strip()))
+    except ValueError:
+        values = ()
+    if not values or min(values) < 1:
+        raise argparse.ArgumentTypeError(f'expected frame counts like 15,40,80, not {text!r}')
+    return values
+
+
 def main(argv: list[str] | None = None) -> int:
     def body() -> int:
         a = build_parser().parse_args(argv)
-        cfg = LookAway(a.crop, a.follow, a.away, a.pan_px)
+        cuts = [(k, LookAway(a.crop, k, a.away, a.pan_px)) for k in a.follow]
         wanted = [s for s in a.sequences.split(',') if s] if a.sequences else None
         made = skipped = 0
         for seq in collect_sequences(a.inputs, wanted):
-            try:
-                folder = write_look_away(seq, a.out / seq.group, cfg)
-            except ValueError as exc:
-                print(f'iemd-make-lookaway: skipped {seq.name}: {exc}')
-                skipped += 1
-                continue
-            made += 1
-            print(f'iemd-make-lookaway: {seq.name} -> {folder}')
+            for k, cfg in cuts:
+                # iemd-eval's --sequences and --split select <source>-follow<N> by <source>
+                name = seq.name if len(cuts) == 1 else f'{seq.name}-follow{k}'
+                try:
+                    folder = write_look_away(seq, a.out / seq.group, cfg, name)
+                except ValueError as exc:
+                    print(f'iemd-make-lookaway: skipped {name}: {exc}')
+                    skipped += 1
+                    continue
+                made += 1
+                print(f'iemd-make-lookaway: {name} -> {folder}')
         print(f'iemd-make-lookaway: {made} sequence(s) written under {a.out}, {skipped} skipped')
         return 0 if made else 2
 

@@ -181,16 +181,18 @@ def _away_origin(boxes: np.ndarray, start, size, frame) -> np.ndarray | None:
     return min(inside, key=lambda c: float(np.linalg.norm(c - start))) if inside else None
 
 
-def write_look_away(seq: Sequence, out_dir, cfg: LookAway = LookAway()) -> Path:
+def write_look_away(
+    seq: Sequence, out_dir, cfg: LookAway = LookAway(), name: str | None = None
+) -> Path:
     """
     Write the look-away sequence of ``seq`` in OTB layout.
 
     (``img/00001.jpg`` ..., ``groundtruth_rect.txt`` with ``NaN`` where the target is out of view)
-    into ``out_dir / <name>``; returns that folder.
+    into ``out_dir / <name>`` (default: the source's name); returns that folder.
     """
     first = read_frame(seq.frame_paths[0])
     origins, (w, h) = look_away_windows(seq, (first.shape[1], first.shape[0]), cfg)
-    folder = Path(out_dir) / seq.name
+    folder = Path(out_dir) / (name or seq.name)
     (folder / 'img').mkdir(parents=True, exist_ok=True)
     lines = []
     for k, (path, box, (ox, oy)) in enumerate(zip(seq.frame_paths, seq.gt_boxes, origins)):

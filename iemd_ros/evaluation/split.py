@@ -42,7 +42,7 @@ import hashlib
 import json
 from pathlib import Path
 
-__all__ = ['PARTS', 'split', 'split_names', 'hash_split']
+__all__ = ['in_part', 'PARTS', 'split', 'split_names', 'hash_split']
 
 PARTS = ('train', 'validation')
 _FILE = Path(__file__).with_name('split.json')
@@ -67,6 +67,17 @@ def split_names(part: str, groups=('otb', 'uav')) -> list[str]:
     if part not in PARTS:
         raise ValueError(f"unknown split part {part!r} (choose from {', '.join(PARTS)})")
     return [name for group in groups for name in split()[part].get(group, [])]
+
+
+def in_part(name: str, part: list[str]) -> bool:
+    """
+    Whether the sequence ``name`` belongs to ``part`` (names from :func:`split_names`).
+
+    It does when it is one of them or is cut from one: ``<name>-<suffix>`` (``Car4-follow40``
+    from Car4, ``Jogging-1-follow15`` from Jogging-1); case-insensitive.
+    """
+    key = name.lower()
+    return any(key == p.lower() or key.startswith(p.lower() + '-') for p in part)
 
 
 def hash_split(names) -> tuple[list[str], list[str]]:
