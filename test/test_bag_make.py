@@ -63,7 +63,7 @@ def seq():
     return shaky_sequence(8)
 
 
-# grey levels; measured at quality 95 on these frames: 3.0 (bgr8), 0.5 (mono8)
+# grey levels, at quality 95 on these frames (docs/decisions.md#test-bounds)
 JPEG_MEAN_ERROR = 4.0
 
 

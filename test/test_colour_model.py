@@ -167,7 +167,7 @@ def test_the_tracker_uses_colour_on_colour_frames_only():
 
 def test_tracks_a_real_colour_otb_excerpt(otb_root):
     """
-    Woman frames 1-100: average overlap > 0.7 (0.78 measured; 0.76 with colour_weight 0).
+    Woman frames 1-100: average overlap > 0.7 (docs/decisions.md#test-bounds).
 
     A colour sequence, so the colour model is on and its start is searched, a fourth after the
     prediction, the flow and the translation filter.

@@ -55,7 +55,7 @@ def test_demo_end_to_end(tmp_path, capsys):
     assert len(g) == len(ng) == N
     ao_g, ao_ng = iou(g, gt).mean(), iou(ng, gt).mean()
     # the table's rows are the scores of these CSVs; with the gyro prior the target is kept closely
-    # (without it only the window's optical flow follows the shake: 81.5 vs 94.5 % when written)
+    # (docs/decisions.md#test-bounds)
     rows = {
         line.split()[0]: line.split()
         for line in text.splitlines()

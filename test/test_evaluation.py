@@ -51,7 +51,7 @@ from iemd_ros.evaluation.ope import (
 import numpy as np
 import pytest
 
-# Measured on Car4 frames 1-20 (OpenCV 5.0.0 contrib): CSRT average overlap 85.8 %, KCF 87.9 %.
+# CSRT on Car4 frames 1-20 (OpenCV 5.0.0 contrib) tracks the car (docs/decisions.md#test-bounds)
 CSRT_CAR4_20_MIN_OVERLAP = 0.75
 
 

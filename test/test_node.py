@@ -137,8 +137,8 @@ def test_detections_follow_the_synthetic_target_at_30hz(ctx, seq):
             assert hyp.class_id == 'target' and 0.0 < hyp.score <= 1.0
             errors.append(np.hypot(cx - seq.gt_centres[k][0], cy - seq.gt_centres[k][1]))
             assert abs(w - seq.gt_boxes[k][2]) < 8 and abs(h - seq.gt_boxes[k][3]) < 8
-        # measured over 12 runs: 6..10 frames processed (the rest dropped as stale, the gyro
-        # bridges the gaps), centre error max 0.45 px; at most one frame lost, after a 470 ms gap
+        # most frames are dropped as stale and the gyro bridges the gaps; at most a third of the
+        # detections empty (docs/decisions.md#test-bounds)
         assert len(errors) >= 3 and empty <= len(dets) // 3, (len(errors), empty)
         assert max(errors) < 3.0, errors
         assert [stamp_ns(a.header) for a in dets] == sorted(stamp_ns(a.header) for a in dets)

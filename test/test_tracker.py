@@ -369,10 +369,10 @@ def test_motion_prior_keeps_a_far_start_from_winning_on_a_small_edge(otb_root):
     Jogging-1 frames 1-69.
 
     At frame 69, as the post begins to hide the runner, the colour model's start lies about a
-    window height below her, on the road; without the motion prior it wins the score (measured: by
-    0.06) and the tracker never comes back.  With the default motion_weight the window stays on
-    her.  (Without the occlusion check, update_confidence 0: with it the window stays on her
-    without the prior too, measured 0.03 window heights off at frame 69.)
+    window height below her, on the road; without the motion prior it wins the score and the
+    tracker never comes back.  With the default motion_weight the window stays on her.  (Without
+    the occlusion check, update_confidence 0: with it the window stays on her without the prior
+    too; docs/decisions.md#test-bounds.)
     """
     seq = load_sequence('Jogging-1', otb_root)
     frames = [read_frame(path) for path in seq.frame_paths[:70]]
@@ -441,8 +441,8 @@ def test_search_prefers_a_window_the_occlusion_check_accepts(otb_root):
     From about frame 115 a parked car hides her legs; at frame 125 the EMD pulls the descent from
     the prediction 20 px down, where the translation filter's response is 0.02 (0.11 on her).
     Scored by the EMD, filter and colour terms that window wins, every later frame is held, and by
-    frame 140 the window is off her (measured: IoU 0).  Preferring a descended window the check
-    accepts keeps it on her.
+    frame 140 the window is off her (docs/decisions.md#test-bounds).  Preferring a descended window
+    the check accepts keeps it on her.
     """
     seq = load_sequence(otb_root / 'Woman')
     tracker = IemdTracker()
@@ -480,7 +480,7 @@ def test_a_window_started_too_large_never_outgrows_the_image(otb_root):
     Car4 from its first box scaled by 1.2 about the centre.
 
     The scale filter learns the road in the window as target and the window grows; without the
-    bound its area exceeded the image's by frame 195 (measured).
+    bound its area exceeds the image's (docs/decisions.md#test-bounds).
     """
     seq = load_sequence(otb_root / 'Car4')
     x, y, w, h = seq.gt_boxes[0]
