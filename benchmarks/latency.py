@@ -43,7 +43,7 @@ to the arrival of the Detection2DArray carrying its stamp (both on the driver's 
   both;
 * ``process-jpeg``: the tracker process with ``image_transport`` "compressed", the frames published
   as JPEG (quality 95) CompressedImage on ``image/compressed``; its latency includes the decoding
-  (about 1.4 ms; "track ms" is the tracker alone).
+  ("track ms" is the tracker alone; docs/decisions.md#transport-profile).
 
 Peer, measured in the same run and setup: an echo node that answers each image with an empty
 Detection2DArray at once (transport + rclpy overhead only).  Frames the tracker drops as stale (it

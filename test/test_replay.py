@@ -93,8 +93,8 @@ import pytest
 N = 10
 # as the errors name them
 BOTH_IMAGE_TYPES = 'sensor_msgs/msg/Image or sensor_msgs/msg/CompressedImage'
-# JPEG (quality 95) against raw on CMU desk frames 0-59 with the gyro: the translation filter's start
-# moves with the JPEG's small grey-level changes (docs/decisions.md#test-bounds)
+# JPEG (quality 95) against raw on CMU desk frames 0-59 with the gyro: the translation filter's
+# start moves with the JPEG's small grey-level changes (docs/decisions.md#test-bounds)
 JPEG_MIN_MEAN_IOU = 0.97
 
 
