@@ -34,34 +34,23 @@ Cost of a lost frame against a tracked one, on look-away sequences (issue #25: a
     iemd-make-lookaway --out /tmp/lookaway
     PYTHONPATH=. python benchmarks/lost_cost.py /tmp/lookaway/otb /tmp/lookaway/uav
 
-Runs IemdTracker from the ground truth over each sequence and times every update; a frame counts as
-lost when the update returns ``lost`` or re-detects the target (the frames that pay for
-re-detection), tracked otherwise.  Prints the mean update time of each kind per sequence and over
-all, and their ratio, both measured in the same run.
+Runs iEMD from the ground truth over each sequence (``iemd-eval``'s one-pass run) and times every
+update; an update counts as lost when it starts or ends with the target lost (the frames that pay
+for re-detection), tracked otherwise.  Prints the mean update time of each kind per sequence and
+over all, and their ratio, both measured in the same run.
 """
 import argparse
 import sys
-import time
 
-from iemd_ros import IemdTracker
-from iemd_ros.datasets.otb import read_frame
-from iemd_ros.evaluation.ope import collect_sequences
-from iemd_ros.tracking import Cause
+from iemd_ros.evaluation.ope import collect_sequences, IemdAdapter, run_tracker
 import numpy as np
 
 
-def _times(seq) -> tuple[list[float], list[float]]:
+def _times(seq) -> tuple[np.ndarray, np.ndarray]:
     """(tracked, lost) update seconds over ``seq`` from its first box."""
-    tracker = IemdTracker()
-    tracker.init(read_frame(seq.frame_paths[0]), seq.gt_boxes[0])
-    tracked, lost = [], []
-    for path in seq.frame_paths[1:]:
-        frame = read_frame(path)
-        t0 = time.perf_counter()
-        result = tracker.update(frame)
-        dt = time.perf_counter() - t0
-        (lost if result.lost or result.cause is Cause.REDETECTED else tracked).append(dt)
-    return tracked, lost
+    run = run_tracker(IemdAdapter(), seq.frames(), seq.gt_boxes[0])
+    lost = ~run.ok[1:] | ~run.ok[:-1]  # update k ends at frame k + 1, starts from frame k
+    return run.update_seconds[~lost], run.update_seconds[lost]
 
 
 def main(argv=None) -> int:
@@ -80,15 +69,16 @@ def main(argv=None) -> int:
     )
     for seq in sequences:
         tracked, lost = _times(seq)
-        all_tracked += tracked
-        all_lost += lost
-        t_ms = 1e3 * np.mean(tracked) if tracked else float('nan')
-        l_ms = 1e3 * np.mean(lost) if lost else float('nan')
+        all_tracked.append(tracked)
+        all_lost.append(lost)
+        t_ms = 1e3 * tracked.mean() if len(tracked) else float('nan')
+        l_ms = 1e3 * lost.mean() if len(lost) else float('nan')
         print(
             f'{seq.name:24s} {len(tracked):8d} {t_ms:7.2f} {len(lost):6d} {l_ms:7.2f} '
             f'{l_ms / t_ms:13.2f}'
         )
-    t_ms, l_ms = 1e3 * np.mean(all_tracked), 1e3 * np.mean(all_lost)
+    all_tracked, all_lost = np.concatenate(all_tracked), np.concatenate(all_lost)
+    t_ms, l_ms = 1e3 * all_tracked.mean(), 1e3 * all_lost.mean()
     print(
         f'{"ALL":24s} {len(all_tracked):8d} {t_ms:7.2f} {len(all_lost):6d} {l_ms:7.2f} '
         f'{l_ms / t_ms:13.2f}'
