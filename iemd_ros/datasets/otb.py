@@ -271,6 +271,17 @@ def is_sequence_folder(folder: str | Path) -> bool:
     return (folder / 'img').is_dir() and bool(_gt_files(folder))
 
 
+def derives_from(name: str, source: str) -> bool:
+    """
+    Whether the target ``name`` is ``source`` or one made from it: ``<source>-<suffix>``.
+
+    A target of a multi-target folder (Jogging-1 of Jogging) or a cut of a sequence
+    (Car4-follow40 of Car4, Jogging-1-follow15 of Jogging-1); case-insensitive.
+    """
+    name, source = name.lower(), source.lower()
+    return name == source or name.startswith(source + '-')
+
+
 def list_sequences(root: str | Path) -> list[str]:
     """
     Names of the OTB targets below ``root``, sorted (Jogging gives Jogging-1 and Jogging-2).

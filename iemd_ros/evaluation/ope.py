@@ -67,6 +67,7 @@ import cv2
 from iemd_ros.common.parallel import run_jobs, Workers
 from iemd_ros.datasets.otb import (
     default_roots,
+    derives_from,
     is_sequence_folder,
     list_sequences,
     load_sequence,
@@ -702,7 +703,7 @@ def _select_targets(inputs: list[str], wanted: list[str] | None) -> dict[str, Pa
         for w in wanted:
             key = w.lower()
             hits = [n for n in found if n.lower() == key] or [
-                n for n in found if n.lower().startswith(key + '-')
+                n for n in found if derives_from(n, key)
             ]
             if not hits:
                 raise ValueError(f'unknown sequence {w!r} (available: {", ".join(found)})')

@@ -42,6 +42,8 @@ import hashlib
 import json
 from pathlib import Path
 
+from iemd_ros.datasets.otb import derives_from
+
 __all__ = ['in_part', 'PARTS', 'split', 'split_names', 'hash_split']
 
 PARTS = ('train', 'validation')
@@ -73,11 +75,9 @@ def in_part(name: str, part: list[str]) -> bool:
     """
     Whether the sequence ``name`` belongs to ``part`` (names from :func:`split_names`).
 
-    It does when it is one of them or is cut from one: ``<name>-<suffix>`` (``Car4-follow40``
-    from Car4, ``Jogging-1-follow15`` from Jogging-1); case-insensitive.
+    It does when it is one of them or made from one (:func:`~iemd_ros.datasets.otb.derives_from`).
     """
-    key = name.lower()
-    return any(key == p.lower() or key.startswith(p.lower() + '-') for p in part)
+    return any(derives_from(name, source) for source in part)
 
 
 def hash_split(names) -> tuple[list[str], list[str]]:
