@@ -132,8 +132,8 @@ def test_without_gyro_the_shake_is_not_followed_and_the_reason_is_given(seq):
     res = _run(p, seq)
     assert not any(r.gyro_used for r in res)
     assert res[0].gyro_reason == 'gyro disabled (use_gyro is false)'
-    # the peer of the test above: the prior matters here
-    assert _centre_errors(res, seq).max() > 20.0
+    # the peer of the test above: without the prior the window misses the bound the gyro keeps
+    assert _centre_errors(res, seq).max() > 6.0
 
 
 def test_no_camera_info_tracks_without_prior_and_warns(seq):

@@ -128,7 +128,13 @@ class TrackerConfig:
         eq='eq. (sparse target model)',
         decision='kernel-bandwidth',
     )
-    n_iter: int = param(20, 'most descent iterations per start', range=(0, 500), eq='Algorithm 1')
+    n_iter: int = param(
+        0,
+        'most descent iterations per start (0: the starts are scored, not descended)',
+        range=(0, 500),
+        eq='Algorithm 1',
+        decision='descent-off',
+    )
     step_px: float = param(
         2.0,
         'first step along -dEMD/dy',

@@ -35,11 +35,12 @@ Algorithm 1 with the extensions of sections 5.1 and 6.1 and discriminative model
 OpenCV-style API: ``init(frame, box)`` then ``update(frame, prior=None)``.
 
 Per frame: the starts (the prediction, the optical flow's, the translation filter's and the colour
-model's windows) are scored; the best by EMD and the best by the search's score are descended
-(Algorithm 1: build the candidate model at the window, solve the EMD, move against its gradient
-while it decreases); the descended window of lower score is kept, preferring one the occlusion
-check accepts; then the scale is estimated at it, and the models learn unless the frame is held or
-lost.
+model's windows) are scored by the EMD between their sparse-coding histograms and the target's;
+the best by EMD and the best by the search's score are descended when ``n_iter`` > 0 (Algorithm 1:
+move against the EMD's gradient while it decreases; the shipped tracker scores the starts without
+descending them, the paper's preset descends); the window of lower score is kept, preferring one
+the occlusion check accepts; then the scale is estimated at it, and the models learn unless the
+frame is held or lost.
 """
 from __future__ import annotations
 
@@ -143,7 +144,7 @@ class _Descent:
 
 class IemdTracker:
     """
-    iEMD visual tracker (Yao & Dani): sparse-coding histograms + EMD gradient descent.
+    iEMD visual tracker (Yao & Dani): sparse-coding histograms, the EMD, its gradient descent.
 
     Parameters
     ----------
@@ -728,6 +729,8 @@ class IemdTracker:
         moves (docs/decisions.md#descent-step).
         """
         cfg = self.config
+        if cfg.n_iter == 0:  # the start as it is: no gradient needed
+            return _Descent(model=model, emd=model.emd()[0])
         half = model.size / 2.0
         axes = window_axes(model.angle)
         emd, grad, _ = model.evaluate(cfg.gradient)  # cached for _search's winners

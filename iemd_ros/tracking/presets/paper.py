@@ -47,6 +47,7 @@ def parameters() -> TrackerConfig:
 
     """
     return TrackerConfig(
+        n_iter=20,
         gradient=Gradient.PAPER,
         scale_estimator=ScaleEstimator.EMD,
         scale_step=0.02,
