@@ -32,8 +32,8 @@
 Which EMD gradient drives Algorithm 1 best?  Descents from perturbed starts on real frames.
 
 For each sequence and a few frames k, the tracker is initialized on frame k-1 at its ground truth
-and Algorithm 1 (``IemdTracker.descend``) runs from starts moved by a random offset of up to
---offset px:
+and Algorithm 1 (``analysis.descend``, the paper's iterations: ``descent_tracker``) runs from
+starts moved by a random offset of up to --offset px:
 
 * next frame: on frame k, from around its ground truth (the model has to bridge a real change of
   appearance, and the ground truth itself is only good to a pixel or two);
@@ -51,10 +51,9 @@ from __future__ import annotations
 import argparse
 
 import cv2
-from iemd_ros import IemdTracker
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.datasets.otb import load_sequence, read_frame
-from iemd_ros.tracking.analysis import descend
+from iemd_ros.tracking.analysis import descend, descent_tracker
 import numpy as np
 
 GRADIENTS = ('paper', 'appearance')
@@ -84,7 +83,7 @@ def main():
         seq = load_sequence(name)
         for k in np.linspace(5, len(seq) - 1, 6).astype(int):
             prev = read_frame(seq.frame_paths[k - 1])
-            tracker = IemdTracker()
+            tracker = descent_tracker()
             tracker.init(prev, seq.gt_boxes[k - 1])
             motion = rng.uniform(-3.0, 3.0, 2)
             frames = {

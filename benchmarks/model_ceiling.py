@@ -39,8 +39,9 @@ For every ``stride``-th frame k, with the target model of frame 1 (no template u
   offsets within +-0.6 window sizes of the ground truth; its IoU with the ground truth.  Scores:
   the EMD of iEMD, and as a peer the negative normalized cross-correlation (NCC) of the frame-1
   window resampled to the template size.  This is what a perfect search could reach with the model.
-* one descent: Algorithm 1 (``IemdTracker.descend``) on frame k from the ground truth of frame
-  k - ``jump`` (IoU with the ground truth of k), against staying at the start.
+* one descent: Algorithm 1 (``analysis.descend``, the paper's iterations: ``descent_tracker``) on
+  frame k from the ground truth of frame k - ``jump`` (IoU with the ground truth of k), against
+  staying at the start.
 * capture range (``--capture``): on 6 frames per sequence, a tracker initialized on that frame (an
   exact model) descends on the same frame from starts 0.05-0.4 window sizes away from the target in
   8 directions; the share of starts that end within 0.05 window sizes of it.
@@ -52,12 +53,11 @@ from __future__ import annotations
 import argparse
 from multiprocessing import Pool
 
-from iemd_ros import IemdTracker
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.evaluation.metrics import iou
 from iemd_ros.evaluation.ope import sequence_names
-from iemd_ros.tracking.analysis import descend, search_context
+from iemd_ros.tracking.analysis import descend, descent_tracker, search_context
 from iemd_ros.tracking.appearance import ImagePyramid, to_gray
 from iemd_ros.tracking.candidate import CandidateModel
 import numpy as np
@@ -91,7 +91,7 @@ def measure(job):
     name, stride, jump = job
     seq = load_sequence(name)
     first = read_frame(seq.frame_paths[0])
-    tracker = IemdTracker()  # descend() and search_context() leave the frame-1 model as it is
+    tracker = descent_tracker()  # descend() and search_context() leave the frame-1 model as it is
     tracker.init(first, seq.gt_boxes[0])
     template_size = tracker.config.template_size
     # the frame-1 window init() sampled (never updated here)
@@ -133,7 +133,7 @@ def capture(name):
     converged, searches = np.zeros(len(CAPTURE_STARTS)), 0
     for k in np.linspace(0, len(seq) - 1, 6).astype(int):
         frame, truth = read_frame(seq.frame_paths[k]), np.asarray(seq.gt_boxes[k], dtype=float)
-        tracker = IemdTracker()
+        tracker = descent_tracker()
         tracker.init(frame, truth)
         centre, size = box_centre(truth), truth[2:]
         for angle in np.linspace(0, 2 * np.pi, 8, endpoint=False):

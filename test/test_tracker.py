@@ -37,7 +37,7 @@ from iemd_ros.common.parallel import InlineExecutor
 from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.evaluation.metrics import iou
 from iemd_ros.tracking import tracker as tracker_module
-from iemd_ros.tracking.analysis import descend, search_context
+from iemd_ros.tracking.analysis import descend, descent_tracker, search_context
 from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.tracking.template import TemplateDictionary
 from iemd_ros.tracking.tracker import _scale_bounds, _visible_fraction, Cause, MIN_SIDE_PX
@@ -136,9 +136,7 @@ def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
     frame0 = texture(seed=1, blob=8)
     box = (130.0, 90.0, 48.0, 40.0)
     frame1 = shifted(frame0, 2.4, -1.7)
-    # the paper's descent (the shipped tracker does not descend: docs/decisions.md#descent-off)
-    config = TrackerConfig(n_iter=20)
-    probed, untouched = IemdTracker(config), IemdTracker(config)
+    probed, untouched = descent_tracker(), descent_tracker()
     probed.init(frame0, box)
     untouched.init(frame0, box)
     result = descend(probed, frame1, (box[0] + 2.4 - 3.0, box[1] - 1.7 + 1.0, 48.0, 40.0))
@@ -149,7 +147,11 @@ def test_descend_runs_algorithm_1_alone_and_leaves_the_tracker_as_it_was():
     assert result.codings == 1 + result.iterations  # the start and each trial step
     assert probed.update(frame1) == untouched.update(frame1)
     with pytest.raises(RuntimeError, match='needs an initialized tracker'):
-        descend(IemdTracker(), frame1, box)
+        descend(descent_tracker(), frame1, box)
+    shipped = IemdTracker()  # does not descend (docs/decisions.md#descent-off)
+    shipped.init(frame0, box)
+    with pytest.raises(ValueError, match='n_iter > 0'):
+        descend(shipped, frame1, box)
     with pytest.raises(ValueError, match='outside'):
         descend(probed, frame1, (-80.0, 10.0, 20.0, 20.0))
 

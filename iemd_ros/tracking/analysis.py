@@ -38,6 +38,7 @@ from __future__ import annotations
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking.appearance import ImagePyramid, to_gray
 from iemd_ros.tracking.candidate import CandidateModel, SearchContext
+from iemd_ros.tracking.config import TrackerConfig
 from iemd_ros.tracking.tracker import (
     _box,
     _check_box,
@@ -48,7 +49,23 @@ from iemd_ros.tracking.tracker import (
 )
 import numpy as np
 
-__all__ = ['search_context', 'descend']
+__all__ = ['search_context', 'descend', 'descent_tracker']
+
+
+def descent_tracker() -> IemdTracker:
+    """
+    Return a tracker that descends as the paper's system does, the shipped tracker otherwise.
+
+    The shipped tracker does not descend (``n_iter`` 0); this one has the ``paper`` preset's
+    ``n_iter``, for :func:`descend`.
+
+    Returns
+    -------
+    IemdTracker
+        Not initialized.
+
+    """
+    return IemdTracker(TrackerConfig(n_iter=TrackerConfig.preset('paper').n_iter))
 
 
 def search_context(
@@ -112,11 +129,14 @@ def descend(tracker: IemdTracker, frame: np.ndarray, box) -> TrackResult:
     RuntimeError
         When the tracker is not initialized.
     ValueError
-        For a bad frame or box.
+        For a bad frame or box, or a tracker that does not descend (``n_iter`` 0: see
+        :func:`descent_tracker`).
 
     """
     if tracker._center is None:
         raise RuntimeError('descend() needs an initialized tracker')
+    if tracker.config.n_iter == 0:
+        raise ValueError('descend() needs a tracker that descends (n_iter > 0): descent_tracker()')
     _check_frame(frame)
     x, y, w, h = _check_box(box, frame.shape)
     size = np.array([w, h], dtype=np.float64)
