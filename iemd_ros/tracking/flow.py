@@ -28,7 +28,7 @@
 # POSSIBILITY OF SUCH DAMAGE.
 
 """
-Median optical flow of the target window: one more starting point for Algorithm 1 (section 6.1).
+Median optical flow of the target window: one more start of the search (section 6.1).
 
 The paper meets abrupt motion with extra starting points around the prediction.  The iEMD
 descent only converges from a few pixels off the target (docs/decisions.md#capture-range), so a
