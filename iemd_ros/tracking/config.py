@@ -130,7 +130,7 @@ class TrackerConfig:
     )
     n_iter: int = param(
         0,
-        'most descent iterations per start (0: the starts are scored, not descended)',
+        'most descent iterations per start (0: each start stays where it is)',
         range=(0, 500),
         eq='Algorithm 1',
         decision='descent-off',

@@ -35,12 +35,12 @@ Algorithm 1 with the extensions of sections 5.1 and 6.1 and discriminative model
 OpenCV-style API: ``init(frame, box)`` then ``update(frame, prior=None)``.
 
 Per frame: the starts (the prediction, the optical flow's, the translation filter's and the colour
-model's windows) are scored by the EMD between their sparse-coding histograms and the target's;
-the best by EMD and the best by the search's score are descended when ``n_iter`` > 0 (Algorithm 1:
-move against the EMD's gradient while it decreases; the shipped tracker scores the starts without
-descending them, the paper's preset descends); the window of lower score is kept, preferring one
-the occlusion check accepts; then the scale is estimated at it, and the models learn unless the
-frame is held or lost.
+model's windows) are compared by the EMD between their sparse-coding histograms and the target's
+and by the search's score; with ``n_iter`` > 0 the best by EMD and the best by score are descended
+(Algorithm 1: move against the EMD's gradient while it decreases; the ``paper`` preset descends,
+the default does not: docs/decisions.md#descent-off); the window of lower score is kept,
+preferring one the occlusion check accepts; then the scale is estimated at it, and the models learn
+unless the frame is held or lost.
 """
 from __future__ import annotations
 
@@ -729,15 +729,15 @@ class IemdTracker:
         moves (docs/decisions.md#descent-step).
         """
         cfg = self.config
-        if cfg.n_iter == 0:  # the start as it is: no gradient needed
-            return _Descent(model=model, emd=model.emd()[0])
         half = model.size / 2.0
         axes = window_axes(model.angle)
-        emd, grad, _ = model.evaluate(cfg.gradient)  # cached for _search's winners
-        # its solve is counted by the caller, with its coding
-        state = _Descent(model=model, emd=emd)
+        # its solve (cached for _search's winners) is counted by the caller, with its coding
+        state = _Descent(model=model, emd=model.emd()[0])
         step, min_step = cfg.step_px, cfg.min_step_px
-        while state.iterations < cfg.n_iter and step >= min_step:
+        grad = None  # dEMD/dy at the current window, computed when a step needs it
+        while state.iterations < cfg.n_iter and step >= min_step and np.isfinite(state.emd):
+            if grad is None:
+                grad = state.model.gradient(cfg.gradient)
             g_px = axes @ (grad / half)  # gradient with respect to image pixels
             norm = np.linalg.norm(g_px)
             if not np.isfinite(norm) or norm == 0:
@@ -747,8 +747,8 @@ class IemdTracker:
             e_try, s_try = trial.emd()
             state.codings += 1
             state.warnings += _not_optimal(s_try)
-            if e_try < state.emd:  # the gradient is needed only where the step is accepted
-                state.model, state.emd, grad = trial, e_try, trial.gradient(cfg.gradient)
+            if e_try < state.emd:  # the next step needs the gradient at the accepted window
+                state.model, state.emd, grad = trial, e_try, None
             else:
                 step *= 0.5
         return state
