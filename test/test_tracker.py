@@ -29,6 +29,7 @@
 
 """IemdTracker: API contract, template update, sub-pixel recovery, a real OTB excerpt."""
 import dataclasses
+import threading
 
 from helpers import rotated, shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
@@ -410,6 +411,7 @@ def test_a_post_hiding_the_runner_holds_or_loses_her_and_nothing_learns(otb_root
     tracker.init(frames[0], seq.gt_boxes[0])
     held, lost = [], []
     for k, frame in enumerate(frames[1:], start=1):
+        tracker.wait_learned()  # the last frame's learning is part of the state before this one
         before = (
             tracker._size.copy(),
             tracker._translation_filter.f.copy(),
@@ -520,7 +522,12 @@ def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
 
 
 def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, monkeypatch):
-    """Woman frames 1-24: the worker threads give the boxes and EMDs of one job after another."""
+    """
+    Woman frames 1-24: the worker and learning threads give the boxes of one job after another.
+
+    In the serial schedule every model runs when it is submitted, and the models have learned from
+    a frame when update returns.
+    """
     seq = load_sequence(otb_root / 'Woman')
     frames = [read_frame(p) for p in seq.frame_paths[:25]]
 
@@ -531,6 +538,51 @@ def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, mon
 
     threaded = run()
     monkeypatch.setattr(tracker_module, '_workers', InlineExecutor)
+    monkeypatch.setattr(tracker_module, '_learner', InlineExecutor)
     serial = run()
+    assert sum(not (r.lost or r.held) for r in serial) >= 20  # most frames learned
     assert [r.box for r in threaded] == [r.box for r in serial]
     assert [r.emd for r in threaded] == [r.emd for r in serial]
+
+
+def test_update_returns_before_the_models_learn_and_the_next_call_waits_for_them(monkeypatch):
+    """
+    The learning of a tracked frame runs after update returns; update, init and wait_learned wait.
+
+    Each learning waits for a token: update returns while it waits, the next update (and init)
+    does not return until it has one, and an error raised while learning is raised by the next
+    call.
+    """
+    frame = texture()
+    box = (100, 80, 40, 40)
+    tokens, started = threading.Semaphore(0), threading.Event()
+    learn = IemdTracker._learn
+
+    def held_learn(self, *args):
+        started.set()
+        assert tokens.acquire(timeout=10)
+        learn(self, *args)
+
+    monkeypatch.setattr(IemdTracker, '_learn', held_learn)
+    tracker = IemdTracker()
+    tracker.init(frame, box)
+    result = tracker.update(frame)
+    assert not (result.lost or result.held) and started.wait(10)
+    for call in (lambda: tracker.update(frame), lambda: tracker.init(frame, box)):
+        caller = threading.Thread(target=call)
+        caller.start()
+        caller.join(0.3)
+        assert caller.is_alive()  # waiting for the last frame's learning
+        tokens.release()
+        caller.join(10)
+        assert not caller.is_alive()
+
+    def failing_learn(self, *args):
+        raise RuntimeError('learning failed')
+
+    monkeypatch.setattr(IemdTracker, '_learn', failing_learn)
+    tracker.init(frame, box)
+    tracker.update(frame)
+    with pytest.raises(RuntimeError, match='learning failed'):
+        tracker.wait_learned()
+    tracker.wait_learned()  # raised once

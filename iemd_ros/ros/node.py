@@ -631,25 +631,29 @@ class _Tracker:
         """
         cfg = self._node_cfg
         results = [r for r in results if r is not None]
-        out = detection_array(RCLPY_MESSAGES, img.header, results, cfg.class_id, cfg.detection_id)
-        bearings = bearing_array(
-            RCLPY_MESSAGES,
-            img.header,
-            results,
-            self.pipeline.camera,
-            cfg.class_id,
-            cfg.detection_id,
-        )
-        annotations = image_annotations(
-            RCLPY_MESSAGES, stamp_ns(img.header), results, cfg.detection_id, box_colour
-        )
         if self._stop or not self._active or not self.context.ok():
             return
-        self._det_pub.publish(out)
+        # the detections first: their latency is the node's
+        self._det_pub.publish(
+            detection_array(RCLPY_MESSAGES, img.header, results, cfg.class_id, cfg.detection_id)
+        )
         # what a detector acts on
         self._lost_pub.publish(Bool(data=self.pipeline.state is TrackState.LOST))
-        self._bearing_pub.publish(bearings)
-        self._annotation_pub.publish(annotations)
+        self._bearing_pub.publish(
+            bearing_array(
+                RCLPY_MESSAGES,
+                img.header,
+                results,
+                self.pipeline.camera,
+                cfg.class_id,
+                cfg.detection_id,
+            )
+        )
+        self._annotation_pub.publish(
+            image_annotations(
+                RCLPY_MESSAGES, stamp_ns(img.header), results, cfg.detection_id, box_colour
+            )
+        )
         self._output_status.tick(
             time.monotonic(),
             (self.get_clock().now().nanoseconds - stamp_ns(img.header)) / 1e9,

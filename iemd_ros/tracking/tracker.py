@@ -40,7 +40,7 @@ and by the search's score; with ``n_iter`` > 0 the best by EMD and the best by s
 (Algorithm 1: move against the EMD's gradient while it decreases; the ``paper`` preset descends,
 the default does not: docs/decisions.md#descent-off); the window of lower score is kept,
 preferring one the occlusion check accepts; then the scale is estimated at it, and the models learn
-unless the frame is held or lost.
+unless the frame is held or lost: after ``update`` has returned, on a thread of their own.
 """
 from __future__ import annotations
 
@@ -174,6 +174,7 @@ class IemdTracker:
         self._frame_index = 0
         self._lost = False
         self._confidence = None
+        self._learning = None  # the models' learning from the last tracked frame (a Future)
 
     # ------------------------------------------------------------------ API
     def init(self, frame: np.ndarray, box) -> None:
@@ -196,6 +197,7 @@ class IemdTracker:
         """
         _check_frame(frame)
         x, y, w, h = _check_box(box, frame.shape)
+        self.wait_learned()
         cfg = self.config
         self._center = box_centre((x, y, w, h))
         self._size = np.array([w, h], dtype=np.float64)
@@ -242,7 +244,8 @@ class IemdTracker:
         Parameters
         ----------
         frame : ndarray
-            HxW or HxWx3 (BGR) uint8 image, the next frame.
+            HxW or HxWx3 (BGR) uint8 image, the next frame.  The models learn from it after this
+            returns: do not write into it before the next call or :meth:`wait_learned`.
         prior : array_like (3, 3), optional
             Homography taking the previous frame's pixels to this frame's (the gyro's ``K R^T
             K^-1``, eq. 23): the prediction moves, turns and scales with it.
@@ -263,6 +266,7 @@ class IemdTracker:
         if self._center is None:
             raise RuntimeError('IemdTracker.update() called before init()')
         _check_frame(frame)
+        self.wait_learned()
         center, size, angle, anchor = (
             self._center.copy(),
             self._size.copy(),
@@ -337,7 +341,10 @@ class IemdTracker:
         if held:
             cause, reason = Cause.LOW_RESPONSE, best.held_reason
         else:
-            self._learn(frame, final, best.confidence, new_center, new_size, angle)
+            # the result goes back now; the models learn on the learning thread meanwhile
+            self._learning = _learner().submit(
+                self._learn, frame, final, best.confidence, new_center, new_size, angle
+            )
         return TrackResult(
             box=_box(new_center, new_size, angle),
             emd=emd,
@@ -353,6 +360,19 @@ class IemdTracker:
             held=held,
             cause=cause,
         )
+
+    def wait_learned(self) -> None:
+        """
+        Wait until the models have learned from the last frame :meth:`update` tracked.
+
+        :meth:`update` returns its result before the models learn from the frame; they learn on a
+        thread of their own, and the next :meth:`update` or :meth:`init` waits for them first.
+        Call this before writing into that frame's buffer or reading the models.  An error raised
+        while learning is raised here.
+        """
+        learning, self._learning = self._learning, None
+        if learning is not None:
+            learning.result()
 
     # ------------------------------------------------------------ internals
     def _lose(
@@ -489,29 +509,27 @@ class IemdTracker:
         if self._colour_now:
             colour = pool.submit(self._colour_model.estimate, frame, center, size, angle)
         tf = self._translation_filter
-        moves = [
-            flow.result() if flow else None,
-            tf.estimate(frame, center, size, angle) if tf is not None else None,
-            colour.result() if colour else None,
-        ]
+        filter_move = tf.estimate(frame, center, size, angle) if tf is not None else None
+        # the prediction's window is coded and solved here while the workers run
+        context = self._context(pyramid, angle)
+        predicted = CandidateModel(context, center, size)
+        predicted.emd()
+        moves = [flow.result() if flow else None, filter_move, colour.result() if colour else None]
         fine_starts = [
             center + move
             for move in moves
             if move is not None and np.linalg.norm(move) >= cfg.min_step_px
         ]
-        best = self._search(pyramid, [center, *fine_starts], size, angle, center)
+        best = self._search(
+            [predicted, *(CandidateModel(context, s, size) for s in fine_starts)], center
+        )
         searches, starts = [best], 1 + len(fine_starts)
         if cfg.n_particles and (
             self._lost or best.emd > cfg.particle_trigger * self._background_emd
         ):
             distance = cfg.particle_offset * (2.0 if self._lost else 1.0)
-            candidate = self._search(
-                pyramid,
-                center + _particle_offsets(cfg.n_particles, distance) * size,
-                size,
-                angle,
-                center,
-            )
+            particles = center + _particle_offsets(cfg.n_particles, distance) * size
+            candidate = self._search([CandidateModel(context, p, size) for p in particles], center)
             starts += cfg.n_particles
             searches.append(candidate)
             if candidate.emd < best.emd:
@@ -654,9 +672,9 @@ class IemdTracker:
             self.layout.positions(), self._target_eps, pooled, self.config.kernel_bandwidth
         )
 
-    def _search(self, pyramid: ImagePyramid, starts, size, angle: float, prediction) -> _Descent:
+    def _search(self, models: list[CandidateModel], prediction) -> _Descent:
         """
-        Algorithm 1 from the ``starts`` (centres).
+        Algorithm 1 from the starts' windows ``models`` (of one size and turn).
 
         The start of lowest EMD is descended, and with the translation filter or the colour model
         also the start of lowest :meth:`_score`; the descended window of lowest score is kept,
@@ -665,8 +683,7 @@ class IemdTracker:
         score's motion prior measures a window's displacement.  The descent's capture range is a
         few pixels (docs/decisions.md#capture-range): the other starts are what reach farther.
         """
-        context = self._context(pyramid, angle)
-        models = [CandidateModel(context, s, size) for s in starts]
+        size = models[0].size
         # each model caches its EMD
         warnings = sum(_not_optimal(model.emd()[1]) for model in models)
         chosen = [min(models, key=lambda model: model.emd()[0])]
@@ -796,9 +813,21 @@ def warm_up() -> None:
     tracker = IemdTracker()
     tracker.init(frame, (16, 16, 32, 32))
     tracker.update(frame)
+    tracker.wait_learned()
 
 
 # ---------------------------------------------------------------- helpers
+@functools.cache
+def _learner() -> ThreadPoolExecutor:
+    """
+    Return the thread the models learn on after :meth:`IemdTracker.update` has returned.
+
+    It is shared by every tracker of the process: one tracker's learning runs beside the next
+    tracker's search.
+    """
+    return ThreadPoolExecutor(max_workers=1, thread_name_prefix='iemd-learn')
+
+
 @functools.cache
 def _workers() -> ThreadPoolExecutor:
     """
