@@ -35,8 +35,8 @@ For each sequence the first ``--frames`` frames are decoded into memory once, th
 runs on them back to back (interleaved per sequence, so load changes on the shared machine hit all
 trackers alike).  Only ``update`` calls are timed; iEMD's update returns before its models learn
 from the frame and the next update waits for them, so back to back each timed update carries the
-learning of the frame before: the times are whole frames.  A tracker that has lost the target may run
-faster (OpenCV skips its model update on a failed frame), so the number of frames each tracker
+learning of the frame before: the times are whole frames.  A tracker that has lost the target may
+run faster (OpenCV skips its model update on a failed frame), so the number of frames each tracker
 reported failed is shown.  Prints median / p95 update time (ms) and fps per tracker, and the fps
 ratio of each tracker against the reference (CSRT by default) per sequence and pooled.
 
