@@ -151,7 +151,7 @@ def test_detections_follow_the_synthetic_target_at_30hz(ctx, seq):
         assert len(dets) == int(v['frames_processed'])
         imu = drv.wait_status('imu', lambda s: True, 2.0)
         assert level(imu) == OK and 'gyro prior used' in imu.message, imu.message
-        assert int(values(imu)['gyro_used']) == len(dets)
+        assert int(values(imu)['gyro_used']) == len(dets), values(imu)
         cam = drv.wait_status('camera_info', lambda s: True, 2.0)
         assert level(cam) == OK
         trk = drv.wait_status('tracking', lambda s: True, 2.0)
@@ -240,8 +240,15 @@ def test_parameters_are_validated_with_reasons(ctx):
         )
         assert all(r.successful for r in ok)
         assert node.get_parameter('tracker.n_iter').value == 10
-        assert drv.wait_for(lambda: node.pipeline.config.tracker.n_iter == 10, 5.0)
-        assert node.pipeline.config.gyro.time_offset_ns == 2_000_000
+        # the service sets the parameters one at a time: each is applied on its own
+        assert drv.wait_for(
+            lambda: (
+                node.pipeline.config.tracker.n_iter == 10
+                and node.pipeline.config.gyro.time_offset_ns == 2_000_000
+                and node.pipeline.config.imu_wait_ms == 5.0
+            ),
+            5.0,
+        ), node.pipeline.config
         cases = {
             # cross-field rule of TrackerConfig
             'tracker.min_step_px': (50.0, 'must not exceed step_px'),
