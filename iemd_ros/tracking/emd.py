@@ -41,12 +41,67 @@ and all their mass is moved, as in the paper (docs/decisions.md#emd-solver).
 from __future__ import annotations
 
 from dataclasses import dataclass
+import importlib
+import importlib.machinery
+import importlib.util
+import os
+import sys
+import types
 
 import numpy as np
 
+
+def _network_simplex():
+    """
+    Return POT's network simplex ``ot.lp.emd_wrap.emd_c`` without running ``ot/__init__.py``.
+
+    The package's ``__init__`` imports all of POT (its datasets import scipy.stats, its Bregman
+    solvers scipy.optimize, ``ot.utils`` scipy.spatial: about 1.5 s of every start); the tracker
+    needs the one compiled solver.  The extension is imported under placeholder ``ot`` and
+    ``ot.lp`` packages (POT's own folders) and a placeholder ``ot.utils`` whose ``dist`` (the one
+    name the extension takes from it, for ``emd_1d_sorted``) calls POT's own on first use; then
+    every ``ot`` module is taken out of ``sys.modules`` again, so that a later ``import ot`` runs
+    POT's ``__init__`` as usual and finds the same extension.  With POT already imported, or when
+    the placeholders fail, it is the plain import (docs/decisions.md#pot-import).
+
+    Returns
+    -------
+    callable
+        ``emd_c(a, b, M, max_iter, num_threads) -> (G, cost, u, v, result_code)``.
+
+    """
+    spec = None if 'ot' in sys.modules else importlib.util.find_spec('ot')
+    if spec is not None and spec.submodule_search_locations:
+        root, before = spec.submodule_search_locations[0], set(sys.modules)
+        try:
+            for name, path in (('ot', root), ('ot.lp', os.path.join(root, 'lp'))):
+                placeholder = importlib.machinery.ModuleSpec(name, None, is_package=True)
+                placeholder.submodule_search_locations = [path]
+                sys.modules[name] = importlib.util.module_from_spec(placeholder)
+            utils = sys.modules['ot.utils'] = types.ModuleType('ot.utils')
+            utils.dist = _pot_dist
+            return importlib.import_module('ot.lp.emd_wrap').emd_c
+        except Exception:  # any failure: the plain import below says what is wrong
+            pass
+        finally:
+            for name in set(sys.modules) - before:
+                if name == 'ot' or name.startswith('ot.'):
+                    del sys.modules[name]
+    from ot.lp.emd_wrap import emd_c
+
+    return emd_c
+
+
+def _pot_dist(*args, **kwargs):
+    """Call POT's ``ot.utils.dist``, imported on the first call."""
+    from ot.utils import dist
+
+    return dist(*args, **kwargs)
+
+
 # POT's network simplex without the backend dispatch of ``ot.emd`` around it
 # (docs/decisions.md#emd-solver)
-from ot.lp.emd_wrap import emd_c
+emd_c = _network_simplex()
 
 _RESULT_MESSAGES = {0: 'infeasible', 1: 'optimal', 2: 'unbounded',
                     3: 'max_iter reached before optimality'}
