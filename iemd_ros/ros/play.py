@@ -75,8 +75,8 @@ def _cdr_converter(reader, msgtype: str, cache: dict, dst_typestore):
     Return the converter of the bag's bytes to ROS 2 CDR bytes.
 
     The identity for rosbag2, rosbags' converter for ROS 1.  The typestores generate their
-    (de)serializers on first use (10-25 ms a type), so they are generated here, before the clock
-    of the timed loop starts.
+    (de)serializers on first use, so they are generated here, before the clock of the timed loop
+    starts (docs/decisions.md#play-converter-warmup).
     """
     if reader.is2:
         return bytes

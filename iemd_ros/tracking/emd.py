@@ -56,7 +56,7 @@ def _network_simplex():
     Return POT's network simplex ``ot.lp.emd_wrap.emd_c`` without running ``ot/__init__.py``.
 
     The package's ``__init__`` imports all of POT (its datasets import scipy.stats, its Bregman
-    solvers scipy.optimize, ``ot.utils`` scipy.spatial: about 1.5 s of every start); the tracker
+    solvers scipy.optimize, ``ot.utils`` scipy.spatial: most of a command's start); the tracker
     needs the one compiled solver.  The extension is imported under placeholder ``ot`` and
     ``ot.lp`` packages (POT's own folders) and a placeholder ``ot.utils`` whose ``dist`` (the one
     name the extension takes from it, for ``emd_1d_sorted``) calls POT's own on first use; then
