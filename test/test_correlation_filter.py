@@ -95,6 +95,18 @@ def test_hog_of_colour_takes_the_strongest_channel_and_a_flat_image_has_none():
     assert np.abs(F.fhog(np.full((16, 16), 77, np.float32))).max() == 0
 
 
+def test_hog_of_uint8_is_the_hog_of_its_float_values_and_a_batch_of_each_patch():
+    """The kernel reads uint8 patches without a float copy: the same maps, bit for bit."""
+    rng = np.random.default_rng(1)
+    col = rng.integers(0, 256, (4, 37, 45, 3), dtype=np.uint8)
+    for patch in (col[0], col[1, :, :, 0]):
+        np.testing.assert_array_equal(F.fhog(patch), F.fhog(patch.astype(np.float32)))
+    batch = F.fhog_batch(col)
+    assert batch.shape == (4, 31, 9, 11)
+    for k in range(4):
+        np.testing.assert_array_equal(batch[k], F.fhog(col[k].astype(np.float32)))
+
+
 # -------------------------------------------------------------------------------- Colour Names
 def test_colour_names_cells_are_the_table_rows_of_their_pixels():
     """

@@ -77,30 +77,26 @@ def colour_names() -> np.ndarray:
     )
 
 
-@numba.njit(cache=True, fastmath=True, nogil=True)
+@numba.njit(inline='always', fastmath=True, nogil=True)
 def _atan2_pos(y, x):
     """
     ``atan2(y, x)`` mapped to [0, 2 pi).
 
     Octant reduction + a degree-7 odd polynomial for atan on [0, 1] (max error 2e-4 rad = 0.01 deg,
-    far below the 20 deg bin width; Piotr's toolbox also uses a table).
+    far below the 20 deg bin width; Piotr's toolbox also uses a table).  Written with selects, not
+    branches, so that a loop over pixels vectorizes.
     """
     ax = abs(x)
     ay = abs(y)
     mx = max(ax, ay)
     mn = min(ax, ay)
-    if mx == 0.0:
-        return 0.0
-    a = mn / mx
+    a = mn / mx if mx != 0.0 else 0.0
     s = a * a
     r = ((-0.0464964749 * s + 0.15931422) * s - 0.327622764) * s * a + a
-    if ay > ax:
-        r = 1.57079637 - r
-    if x < 0.0:
-        r = 3.14159274 - r
-    if y < 0.0:
-        r = 6.28318548 - r
-    return r
+    r = 1.57079637 - r if ay > ax else r
+    r = 3.14159274 - r if x < 0.0 else r
+    r = 6.28318548 - r if y < 0.0 else r
+    return r if mx != 0.0 else 0.0
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
@@ -109,37 +105,35 @@ def _grad_bins(img, cell, O0, M0):
     Per pixel: the nearest of 18 orientation bins ``O0`` and the vote ``M0`` (magnitude / cell^2).
 
     Both are those of the colour channel of largest gradient (centred differences, one-sided at
-    the border).
+    the border; the first channel on a tie).  ``img`` is (H, W, C) uint8 or float32.  A row at a
+    time: the channels' gradients into row buffers, then the orientations of the row.
     """
     H, W, C = img.shape
     norm = 1.0 / (cell * cell)
     omult = 18.0 / (2.0 * math.pi)
+    gxb = np.empty(W)
+    gyb = np.empty(W)
+    best = np.empty(W)
     for y in range(H):
         ym = y - 1 if y > 0 else 0
         yp = y + 1 if y < H - 1 else H - 1
         fy = 0.5 if (y > 0 and y < H - 1) else 1.0
-        for x in range(W):
-            xm = x - 1 if x > 0 else 0
-            xp = x + 1 if x < W - 1 else W - 1
-            fx = 0.5 if (x > 0 and x < W - 1) else 1.0
-            best = -1.0
-            gxb = 0.0
-            gyb = 0.0
-            for c in range(C):
-                gx = fx * (img[y, xp, c] - img[y, xm, c])
-                gy = fy * (img[yp, x, c] - img[ym, x, c])
+        for c in range(C):
+            for x in range(W):
+                xm = x - 1 if x > 0 else 0
+                xp = x + 1 if x < W - 1 else W - 1
+                fx = 0.5 if (x > 0 and x < W - 1) else 1.0
+                gx = fx * (np.float32(img[y, xp, c]) - np.float32(img[y, xm, c]))
+                gy = fy * (np.float32(img[yp, x, c]) - np.float32(img[ym, x, c]))
                 m2 = gx * gx + gy * gy
-                if m2 > best:
-                    best = m2
-                    gxb = gx
-                    gyb = gy
-            m = math.sqrt(best)
-            o = _atan2_pos(gyb, gxb) * omult
-            o0 = int(o + 0.5)
-            if o0 >= 18:
-                o0 -= 18
-            O0[y, x] = o0
-            M0[y, x] = m * norm
+                if c == 0 or m2 > best[x]:
+                    best[x] = m2
+                    gxb[x] = gx
+                    gyb[x] = gy
+        for x in range(W):
+            o0 = int(_atan2_pos(gyb[x], gxb[x]) * omult + 0.5)
+            O0[y, x] = o0 - 18 if o0 >= 18 else o0
+            M0[y, x] = math.sqrt(best[x]) * norm
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
@@ -155,14 +149,21 @@ def _accumulate(O0, M0, cell, R):
     hb = H // cell
     wb = W // cell
     inv = 1.0 / cell
+    nx = wb * cell
+    # the column's cell and weight are the same on every row
+    xb0s = np.empty(nx, np.int64)
+    xds = np.empty(nx)
+    for x in range(nx):
+        xb = (x + 0.5) * inv - 0.5
+        xb0s[x] = int(math.floor(xb))
+        xds[x] = xb - xb0s[x]
     for y in range(hb * cell):
         yb = (y + 0.5) * inv - 0.5
         yb0 = int(math.floor(yb))
         yd = yb - yb0
-        for x in range(wb * cell):
-            xb = (x + 0.5) * inv - 0.5
-            xb0 = int(math.floor(xb))
-            xd = xb - xb0
+        for x in range(nx):
+            xb0 = xb0s[x]
+            xd = xds[x]
             o0 = O0[y, x]
             m0 = M0[y, x]
             R[yb0 + 1, xb0 + 1, o0] += (1.0 - yd) * (1.0 - xd) * m0
@@ -174,7 +175,7 @@ def _accumulate(O0, M0, cell, R):
 @numba.njit(cache=True, fastmath=True, nogil=True)
 def _fhog_into(img, cell, clip, out, off):
     """
-    Write the 31 fHOG channels of ``img`` (H, W, C) float32 into ``out[off:off+31]``.
+    Write the 31 fHOG channels of ``img`` (H, W, C) uint8 or float32 into ``out[off:off+31]``.
 
     See the module docstring.
     """
@@ -184,22 +185,17 @@ def _fhog_into(img, cell, clip, out, off):
     O0 = np.empty((H, W), np.int32)
     M0 = np.empty((H, W), np.float32)
     _grad_bins(img, cell, O0, M0)
-    Rp = np.zeros((hb + 2, wb + 2, 18), np.float32)
-    _accumulate(O0, M0, cell, Rp)
-    R1 = np.empty((18, hb, wb), np.float32)
+    R = np.zeros((hb + 2, wb + 2, 18), np.float32)
+    _accumulate(O0, M0, cell, R)
+    # cell energies of the contrast-insensitive histograms (cell (i, j) is R[i + 1, j + 1])
+    E = np.empty((hb, wb), np.float32)
     for i in range(hb):
         for j in range(wb):
-            for o in range(18):
-                R1[o, i, j] = Rp[i + 1, j + 1, o]
-    # contrast-insensitive histograms and cell energies
-    R2 = np.empty((9, hb, wb), np.float32)
-    E = np.zeros((hb, wb), np.float32)
-    for o in range(9):
-        for i in range(hb):
-            for j in range(wb):
-                v = R1[o, i, j] + R1[o + 9, i, j]
-                R2[o, i, j] = v
-                E[i, j] += v * v
+            e = np.float32(0.0)
+            for o in range(9):
+                v = R[i + 1, j + 1, o] + R[i + 1, j + 1, o + 9]
+                e += v * v
+            E[i, j] = e
     # block normalization factors: block (i, j) = cells (i..i+1, j..j+1); index (i+1, j+1) of N;
     # edges replicated
     eps = 1e-4 / 4.0 / cell / cell / cell / cell
@@ -227,7 +223,7 @@ def _fhog_into(img, cell, clip, out, off):
             t2 = 0.0
             t3 = 0.0
             for o in range(18):
-                v = R1[o, i, j]
+                v = R[i + 1, j + 1, o]
                 a0 = min(v * n0, clip)
                 a1 = min(v * n1, clip)
                 a2 = min(v * n2, clip)
@@ -238,7 +234,7 @@ def _fhog_into(img, cell, clip, out, off):
                 t2 += a2
                 t3 += a3
             for o in range(9):
-                v = R2[o, i, j]
+                v = R[i + 1, j + 1, o] + R[i + 1, j + 1, o + 9]
                 out[off + 18 + o, i, j] = 0.5 * (
                     min(v * n0, clip) + min(v * n1, clip) + min(v * n2, clip) + min(v * n3, clip)
                 )
@@ -246,6 +242,12 @@ def _fhog_into(img, cell, clip, out, off):
             out[off + 28, i, j] = r * t1
             out[off + 29, i, j] = r * t2
             out[off + 30, i, j] = r * t3
+
+
+def _kernel_input(img) -> np.ndarray:
+    """Return ``img`` for the fHOG kernel: uint8 as it is (exact differences), else float32."""
+    a = np.asarray(img)
+    return a if a.dtype == np.uint8 else a.astype(np.float32)
 
 
 def fhog(img: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
@@ -268,7 +270,7 @@ def fhog(img: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.ndarray:
         (31, H // cell, W // cell) float32.
 
     """
-    a = np.asarray(img, dtype=np.float32)
+    a = _kernel_input(img)
     if a.ndim == 2:
         a = a[:, :, None]
     a = np.ascontiguousarray(a)
@@ -357,7 +359,7 @@ def extract(
     if out is None:
         out = np.empty(shape, np.float32)
     _colour_into(a, cell, colour_names(), colour, out, 0, 1 + N_HOG)
-    _fhog_into(a.astype(np.float32), cell, np.float32(0.2), out, 1)
+    _fhog_into(a, cell, np.float32(0.2), out, 1)
     return out
 
 
@@ -373,7 +375,7 @@ def fhog_batch(patches: np.ndarray, cell: int = CELL, clip: float = 0.2) -> np.n
 
     The maps are ``(K, 31, H // cell, W // cell)`` float32.
     """
-    p = np.ascontiguousarray(patches, dtype=np.float32)
+    p = np.ascontiguousarray(_kernel_input(patches))
     if p.ndim == 3:
         p = p[..., None]
     out = np.zeros((p.shape[0], N_HOG, p.shape[1] // cell, p.shape[2] // cell), np.float32)
