@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+# Copyright 2026 iemd_ros authors
+# SPDX-License-Identifier: BSD-3-Clause
+#
+# Redistribution and use in source and binary forms, with or without
+# modification, are permitted provided that the following conditions are met:
+#
+#    * Redistributions of source code must retain the above copyright
+#      notice, this list of conditions and the following disclaimer.
+#
+#    * Redistributions in binary form must reproduce the above copyright
+#      notice, this list of conditions and the following disclaimer in the
+#      documentation and/or other materials provided with the distribution.
+#
+#    * Neither the name of the iemd_ros authors nor the names of its
+#      contributors may be used to endorse or promote products derived from
+#      this software without specific prior written permission.
+#
+# THIS SOFTWARE IS PROVIDED BY THE COPYRIGHT HOLDERS AND CONTRIBUTORS "AS IS"
+# AND ANY EXPRESS OR IMPLIED WARRANTIES, INCLUDING, BUT NOT LIMITED TO, THE
+# IMPLIED WARRANTIES OF MERCHANTABILITY AND FITNESS FOR A PARTICULAR PURPOSE
+# ARE DISCLAIMED. IN NO EVENT SHALL THE COPYRIGHT HOLDER OR CONTRIBUTORS BE
+# LIABLE FOR ANY DIRECT, INDIRECT, INCIDENTAL, SPECIAL, EXEMPLARY, OR
+# CONSEQUENTIAL DAMAGES (INCLUDING, BUT NOT LIMITED TO, PROCUREMENT OF
+# SUBSTITUTE GOODS OR SERVICES; LOSS OF USE, DATA, OR PROFITS; OR BUSINESS
+# INTERRUPTION) HOWEVER CAUSED AND ON ANY THEORY OF LIABILITY, WHETHER IN
+# CONTRACT, STRICT LIABILITY, OR TORT (INCLUDING NEGLIGENCE OR OTHERWISE)
+# ARISING IN ANY WAY OUT OF THE USE OF THIS SOFTWARE, EVEN IF ADVISED OF THE
+# POSSIBILITY OF SUCH DAMAGE.
+
+"""
+Ceiling of the tracker's choices: its own average overlap against an oracle that chooses for it.
+
+    PYTHONPATH=. python benchmarks/choice_ceiling.py [--split train|validation] [--sequences Car4]
+                                                     [--jobs 2]
+
+Every sequence of ``../shared`` (OTB and drone) is tracked from the ground truth four times:
+
+* ``tracker``: the shipped tracker as it is;
+* ``start``: on every annotated frame the search is handed only the start (the prediction, the
+  flow's, the filter's or the colour model's window) whose centre is nearest the true centre; the
+  rest (the occlusion check, the scale, learning, the lost state) is the tracker's own;
+* ``scale``: the scale filter's estimate replaced by the true size over the window's size;
+* ``both``: the two together.
+
+Printed: the average overlap per sequence and the mean, per variant.  The gap between ``tracker``
+and ``start`` is what a better choice among the starts the tracker already has could win, with
+nothing new to find the target; ``scale`` is the same for the size
+(docs/decisions.md#choice-ceiling).
+"""
+import argparse
+from multiprocessing import Pool
+import sys
+
+from iemd_ros.common.boxes import box_centre
+from iemd_ros.datasets.otb import load_sequence
+from iemd_ros.evaluation.metrics import score_sequence
+from iemd_ros.evaluation.ope import sequence_names
+from iemd_ros.evaluation.split import in_part, PARTS, split_names
+from iemd_ros.tracking.tracker import IemdTracker
+import numpy as np
+
+VARIANTS = ('tracker', 'start', 'scale', 'both')
+
+
+class OracleTracker(IemdTracker):
+    """The shipped tracker, its start choice and / or its scale taken from the ground truth."""
+
+    def __init__(self, gt: np.ndarray, start: bool, scale: bool):
+        super().__init__()
+        self._gt, self._oracle_start, self._oracle_scale = gt, start, scale
+
+    def _truth(self):
+        """Return the ground-truth box of the frame being tracked, or None where it is absent."""
+        box = self._gt[self._frame_index]
+        return box if np.all(np.isfinite(box)) else None
+
+    def _search(self, models, prediction):
+        truth = self._truth()
+        if self._oracle_start and truth is not None:
+            centre = box_centre(truth)
+            models = [min(models, key=lambda m: float(np.linalg.norm(m.center - centre)))]
+        return super()._search(models, prediction)
+
+    def _estimate_scale(self, frame, best, bounds):
+        found, scale = super()._estimate_scale(frame, best, bounds)
+        truth = self._truth()
+        if self._oracle_scale and truth is not None:
+            scale = float(np.sqrt(truth[2] * truth[3] / np.prod(best.model.size)))
+        return found, scale
+
+
+def run(job) -> tuple[str, str, float]:
+    """Return (sequence, variant, average overlap) of one run from the ground truth."""
+    name, variant = job
+    seq = load_sequence(name)
+    gt = np.asarray(seq.gt_boxes, dtype=float)
+    tracker = OracleTracker(gt, variant in ('start', 'both'), variant in ('scale', 'both'))
+    boxes = [gt[0]]
+    frames = seq.frames()
+    tracker.init(next(frames), tuple(gt[0]))
+    boxes += [tracker.update(frame).box for frame in frames]
+    return name, variant, score_sequence(np.asarray(boxes), gt, name).average_overlap
+
+
+def main(argv=None) -> int:
+    p = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
+    p.add_argument('--split', choices=PARTS, default=None, help='one part of the fixed split')
+    p.add_argument('--sequences', default=None, help='comma-separated names (default: all)')
+    p.add_argument('--jobs', type=int, default=2, help='runs side by side (processes)')
+    args = p.parse_args(argv)
+    try:
+        names = sequence_names(args.sequences)
+    except ValueError as e:
+        print(f'choice_ceiling.py: {e}', file=sys.stderr)
+        return 2
+    if args.split is not None:
+        names = [n for n in names if in_part(n, split_names(args.split))]
+    jobs = [(n, v) for n in names for v in VARIANTS]
+    with Pool(max(args.jobs, 1)) as pool:
+        ao = {(n, v): a for n, v, a in pool.map(run, jobs)}
+    print(f'{"sequence":16s}' + ''.join(f'{v:>9s}' for v in VARIANTS))
+    for n in names:
+        print(f'{n:16s}' + ''.join(f'{100 * ao[n, v]:9.1f}' for v in VARIANTS))
+    means = [100 * np.mean([ao[n, v] for n in names]) for v in VARIANTS]
+    print(f'{"mean":16s}' + ''.join(f'{m:9.1f}' for m in means))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
