@@ -54,8 +54,7 @@ import sys
 
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.datasets.otb import load_sequence
-from iemd_ros.evaluation.metrics import score_sequence
-from iemd_ros.evaluation.ope import sequence_names
+from iemd_ros.evaluation.ope import evaluate_sequence, IemdAdapter, sequence_names
 from iemd_ros.evaluation.split import in_part, PARTS, split_names
 from iemd_ros.tracking.tracker import IemdTracker
 import numpy as np
@@ -90,17 +89,23 @@ class OracleTracker(IemdTracker):
         return found, scale
 
 
+class OracleAdapter(IemdAdapter):
+    """:class:`OracleTracker` in `iemd-eval`'s one-pass run and scoring."""
+
+    def __init__(self, gt: np.ndarray, start: bool, scale: bool):
+        super().__init__()
+        self._tracker = OracleTracker(gt, start, scale)
+
+
 def run(job) -> tuple[str, str, float]:
     """Return (sequence, variant, average overlap) of one run from the ground truth."""
     name, variant = job
     seq = load_sequence(name)
-    gt = np.asarray(seq.gt_boxes, dtype=float)
-    tracker = OracleTracker(gt, variant in ('start', 'both'), variant in ('scale', 'both'))
-    boxes = [gt[0]]
-    frames = seq.frames()
-    tracker.init(next(frames), tuple(gt[0]))
-    boxes += [tracker.update(frame).box for frame in frames]
-    return name, variant, score_sequence(np.asarray(boxes), gt, name).average_overlap
+    oracle = OracleAdapter(
+        np.asarray(seq.gt_boxes, dtype=float), variant in ('start', 'both'),
+        variant in ('scale', 'both'),
+    )
+    return name, variant, evaluate_sequence(seq, oracle)[0].average_overlap
 
 
 def main(argv=None) -> int:
