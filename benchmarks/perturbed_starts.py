@@ -45,17 +45,25 @@ scale variations, and the ground truth).  Each run is scored over all its frames
 truth (iemd_ros.evaluation.metrics).  Printed per tracker: the mean average overlap over sequences
 and starts, its mean per start, per sequence, and the median update time.  ``--config`` runs iEMD
 with other TrackerConfig values (default: the defaults), each against the same peers.
+
+A difference between two trackers is printed run by run (``paired_difference``: the mean difference
+in points, its 95 % interval with whole sequences resampled, the runs better, worse and equal):
+every configuration after the first against the first, and, with ``--against FILE``, every tracker
+of this run against the first of a run saved by ``--save FILE`` (the same starts and shift; another
+source tree, say).
 """
 from __future__ import annotations
 
 import argparse
 import ast
+import json
 from multiprocessing import Pool
+from pathlib import Path
 
 from iemd_ros import TrackerConfig
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.datasets.otb import load_sequence
-from iemd_ros.evaluation.metrics import score_sequence
+from iemd_ros.evaluation.metrics import paired_difference, score_sequence
 from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.split import PARTS, split_names
 import numpy as np
@@ -136,7 +144,14 @@ def main() -> None:
         help='diagonal: the ground truth and 4 diagonal shifts; sre: also 4 axis shifts, 4 scales',
     )
     parser.add_argument('--jobs', type=int, default=2)
+    parser.add_argument(
+        '--save', type=Path, help='write the average overlap of every run to this JSON file'
+    )
+    parser.add_argument(
+        '--against', type=Path, help='compare with the first tracker of a run saved by --save'
+    )
     args = parser.parse_args()
+    reference = None if args.against is None else _load_reference(args.against, args)
     names = sequence_names(args.sequences)
     if args.split is not None:
         names = [n for n in names if n in split_names(args.split)]
@@ -169,9 +184,11 @@ def main() -> None:
         'of its size '
         f'along {which})'
     )
+    overlaps = {}
     for i, (label, _, _) in enumerate(runs):
         rows = [row for per_sequence in results for row in per_sequence[i]]
         overlap = np.array([ao for ao, _ in rows]).reshape(len(names), n_starts) * 100
+        overlaps[label] = overlap
         speed = np.median([ms for _, ms in rows])
         starts = ' '.join(f'{v:4.1f}' for v in overlap.mean(axis=0))
         print(
@@ -185,6 +202,54 @@ def main() -> None:
                 f'sequences x {n_starts}'
             )
         print('    ' + ' '.join(f'{n}={v:.1f}' for n, v in zip(names, overlap.mean(axis=1))))
+        first = runs[0][0]
+        if i > 0 and runs[i][1] == 'iemd':
+            _print_difference(overlap, overlaps[first], first)
+        if reference is not None:
+            ref_label, ref_runs = reference
+            missing = [n for n in names if n not in ref_runs]
+            if missing:
+                raise SystemExit(f'--against {args.against}: no run of {", ".join(missing)}')
+            _print_difference(
+                overlap, np.array([ref_runs[n] for n in names]), f'{ref_label} ({args.against})'
+            )
+    if args.save is not None:
+        args.save.write_text(
+            json.dumps(
+                {
+                    'starts': args.starts,
+                    'shift': args.shift,
+                    'runs': {
+                        label: {n: [round(float(v), 4) for v in row] for n, row in zip(names, o)}
+                        for label, o in overlaps.items()
+                    },
+                },
+                indent=1,
+            )
+        )
+
+
+def _print_difference(ours: np.ndarray, reference: np.ndarray, label: str) -> None:
+    d = paired_difference(ours, reference)
+    print(
+        f'    against {label}: {d.mean:+.1f} points, 95 % interval over sequences {d.low:+.1f} .. '
+        f'{d.high:+.1f}; runs better / worse / equal {d.better} / {d.worse} / {d.equal}'
+    )
+
+
+def _load_reference(path: Path, args) -> tuple[str, dict[str, list[float]]]:
+    """(label, {sequence: AO % per start}) of the first tracker saved in ``path`` by --save."""
+    try:
+        saved = json.loads(path.read_text())
+        label, runs = next(iter(saved['runs'].items()))
+    except (OSError, ValueError, KeyError, StopIteration, AttributeError) as exc:
+        raise SystemExit(f'--against {path}: not a run saved by --save ({exc})') from None
+    if (saved.get('starts'), saved.get('shift')) != (args.starts, args.shift):
+        raise SystemExit(
+            f'--against {path}: saved with --starts {saved.get("starts")} --shift '
+            f'{saved.get("shift")}, this run uses --starts {args.starts} --shift {args.shift}'
+        )
+    return label, runs
 
 
 if __name__ == '__main__':

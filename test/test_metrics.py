@@ -34,6 +34,7 @@ from iemd_ros.evaluation.metrics import (
     fraction_above,
     iou,
     OTB_THRESHOLDS,
+    paired_difference,
     precision_at,
     score_sequence,
     success_auc,
@@ -162,3 +163,37 @@ def test_score_sequence_errors():
         score_sequence(np.zeros((2, 4)), np.ones((3, 4)), 'x')
     with pytest.raises(ValueError, match='no frame has a valid'):
         score_sequence(np.zeros((2, 4)), np.full((2, 4), np.nan), 'x')
+
+
+def test_a_gain_on_every_run_has_a_tight_interval_and_one_sequence_alone_does_not():
+    reference = np.arange(50.0).reshape(10, 5)
+    shifted = paired_difference(reference + 2.0, reference)
+    assert (shifted.mean, shifted.low, shifted.high) == pytest.approx((2.0, 2.0, 2.0))
+    assert (shifted.better, shifted.worse, shifted.equal) == (50, 0, 0)
+    # one sequence far better, the nine others a little worse: the mean is positive, the interval
+    # over sequences is not
+    ours = reference - 1.0
+    ours[3] += 21.0
+    lucky = paired_difference(ours, reference)
+    assert lucky.mean == pytest.approx((5 * 20 - 45) / 50)
+    assert lucky.low < 0 < lucky.high
+    assert (lucky.better, lucky.worse, lucky.equal) == (5, 45, 0)
+    # the draws are seeded: the same inputs give the same interval
+    assert paired_difference(ours, reference) == lucky
+    ties = paired_difference(reference, reference)
+    assert (ties.mean, ties.equal) == (0.0, 50)
+
+
+@pytest.mark.parametrize(
+    'ours, reference, kwargs, message',
+    [
+        (np.zeros(5), np.zeros(5), {}, 'sequences, starts'),
+        (np.zeros((2, 3)), np.zeros((3, 2)), {}, 'one shape'),
+        (np.zeros((0, 3)), np.zeros((0, 3)), {}, 'one shape'),
+        (np.full((2, 2), np.nan), np.zeros((2, 2)), {}, 'finite'),
+        (np.zeros((2, 2)), np.zeros((2, 2)), {'resamples': 0}, 'resamples'),
+    ],
+)
+def test_paired_difference_refuses_what_it_cannot_compare(ours, reference, kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        paired_difference(ours, reference, **kwargs)

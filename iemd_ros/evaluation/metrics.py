@@ -507,3 +507,69 @@ def long_term_scores(pred_boxes, reported, gt_boxes) -> LongTermScores:
         reacquired=sum(d >= 0 for d in delays),
         delays=delays,
     )
+
+
+@dataclass
+class PairedDifference:
+    """How one tracker's runs differ from another's on the same sequences and starts."""
+
+    mean: float  # mean of the per-run differences (ours - reference)
+    low: float  # 2.5th percentile of the mean over sequences resampled with replacement
+    high: float  # 97.5th percentile of that mean
+    better: int  # runs where ours is higher
+    worse: int  # runs where ours is lower
+    equal: int  # runs with the same value
+
+
+def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) -> PairedDifference:
+    """
+    Compare two trackers run by run, with a confidence interval that respects the sequences.
+
+    The starts of one sequence are not independent runs (one hard sequence moves all of them), so
+    the interval is a cluster bootstrap: whole sequences are drawn with replacement and the mean
+    difference of the drawn rows is taken, ``resamples`` times (Field & Welsh, "Bootstrapping
+    clustered data", JRSS B 2007).
+
+    Parameters
+    ----------
+    ours, reference : array_like
+        (sequences, starts) scores of the same runs (e.g. average overlap per start).
+    resamples : int, optional
+        Bootstrap draws (>= 1).
+    seed : int, optional
+        Seed of the draws: the same inputs give the same interval.
+
+    Returns
+    -------
+    PairedDifference
+        The mean difference, its 95 % interval and the runs better, worse and equal.
+
+    Raises
+    ------
+    ValueError
+        For arrays that are not 2-D of the same shape, empty, or not finite, or ``resamples`` < 1.
+
+    """
+    a = np.asarray(ours, dtype=np.float64)
+    b = np.asarray(reference, dtype=np.float64)
+    if a.ndim != 2 or a.shape != b.shape or a.size == 0:
+        raise ValueError(
+            f'ours and reference must be (sequences, starts) arrays of one shape, got {a.shape} '
+            f'and {b.shape}'
+        )
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        raise ValueError('ours and reference must be finite')
+    if resamples < 1:
+        raise ValueError(f'resamples must be >= 1, got {resamples}')
+    diff = a - b
+    rows = np.random.default_rng(seed).integers(0, len(diff), size=(resamples, len(diff)))
+    means = diff[rows].mean(axis=(1, 2))
+    low, high = np.percentile(means, [2.5, 97.5])
+    return PairedDifference(
+        mean=float(diff.mean()),
+        low=float(low),
+        high=float(high),
+        better=int((diff > 0).sum()),
+        worse=int((diff < 0).sum()),
+        equal=int((diff == 0).sum()),
+    )
