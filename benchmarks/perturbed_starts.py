@@ -220,7 +220,7 @@ def main() -> None:
                     'starts': args.starts,
                     'shift': args.shift,
                     'runs': {
-                        label: {n: [round(float(v), 4) for v in row] for n, row in zip(names, o)}
+                        label: {n: [float(v) for v in row] for n, row in zip(names, o)}
                         for label, o in overlaps.items()
                     },
                 },
