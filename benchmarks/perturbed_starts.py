@@ -151,10 +151,15 @@ def main() -> None:
         '--against', type=Path, help='compare with the first tracker of a run saved by --save'
     )
     args = parser.parse_args()
-    reference = None if args.against is None else _load_reference(args.against, args)
     names = sequence_names(args.sequences)
     if args.split is not None:
         names = [n for n in names if n in split_names(args.split)]
+    # checked before any run: a saved run without these sequences fails at once
+    reference = (
+        None
+        if args.against is None
+        else _load_reference(args.against, args.starts, args.shift, names)
+    )
     # Checked here, before any run: a bad key or peer fails at once with its own message.
     runs = [
         (
@@ -185,6 +190,7 @@ def main() -> None:
         f'along {which})'
     )
     overlaps = {}
+    first = runs[0][0]
     for i, (label, _, _) in enumerate(runs):
         rows = [row for per_sequence in results for row in per_sequence[i]]
         overlap = np.array([ao for ao, _ in rows]).reshape(len(names), n_starts) * 100
@@ -202,17 +208,11 @@ def main() -> None:
                 f'sequences x {n_starts}'
             )
         print('    ' + ' '.join(f'{n}={v:.1f}' for n, v in zip(names, overlap.mean(axis=1))))
-        first = runs[0][0]
         if i > 0 and runs[i][1] == 'iemd':
             _print_difference(overlap, overlaps[first], first)
         if reference is not None:
-            ref_label, ref_runs = reference
-            missing = [n for n in names if n not in ref_runs]
-            if missing:
-                raise SystemExit(f'--against {args.against}: no run of {", ".join(missing)}')
-            _print_difference(
-                overlap, np.array([ref_runs[n] for n in names]), f'{ref_label} ({args.against})'
-            )
+            ref_label, ref_overlap = reference
+            _print_difference(overlap, ref_overlap, f'{ref_label} ({args.against})')
     if args.save is not None:
         args.save.write_text(
             json.dumps(
@@ -237,19 +237,27 @@ def _print_difference(ours: np.ndarray, reference: np.ndarray, label: str) -> No
     )
 
 
-def _load_reference(path: Path, args) -> tuple[str, dict[str, list[float]]]:
-    """(label, {sequence: AO % per start}) of the first tracker saved in ``path`` by --save."""
+def _load_reference(path: Path, starts: str, shift: float, names) -> tuple[str, np.ndarray]:
+    """
+    (label, AO % per sequence of ``names`` and start) of the first tracker saved by --save.
+
+    SystemExit with one line for a file that is not such a run, or one of other starts or shift, or
+    without a run of one of ``names``.
+    """
     try:
         saved = json.loads(path.read_text())
         label, runs = next(iter(saved['runs'].items()))
     except (OSError, ValueError, KeyError, StopIteration, AttributeError) as exc:
         raise SystemExit(f'--against {path}: not a run saved by --save ({exc})') from None
-    if (saved.get('starts'), saved.get('shift')) != (args.starts, args.shift):
+    if (saved.get('starts'), saved.get('shift')) != (starts, shift):
         raise SystemExit(
             f'--against {path}: saved with --starts {saved.get("starts")} --shift '
-            f'{saved.get("shift")}, this run uses --starts {args.starts} --shift {args.shift}'
+            f'{saved.get("shift")}, this run uses --starts {starts} --shift {shift}'
         )
-    return label, runs
+    missing = [n for n in names if n not in runs]
+    if missing:
+        raise SystemExit(f'--against {path}: no run of {", ".join(missing)}')
+    return label, np.array([runs[n] for n in names])
 
 
 if __name__ == '__main__':
