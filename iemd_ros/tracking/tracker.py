@@ -202,8 +202,8 @@ class IemdTracker:
         self._center = box_centre((x, y, w, h))
         self._size = np.array([w, h], dtype=np.float64)
         self._angle = 0.0
-        self._previous = None
-        _, _, pyramid = self._take_frame(frame)
+        grey, pyramid = self._take_frame(frame)
+        self._previous = grey if cfg.flow_start else None
         template = pyramid.sample(self._center, self._size, cfg.template_size)
         self.dictionary = TemplateDictionary(
             self.layout, cfg.n_templates, cfg.lam, cfg.forgetting, cfg.reconstruction_lambda
@@ -266,7 +266,6 @@ class IemdTracker:
         if self._center is None:
             raise RuntimeError('IemdTracker.update() called before init()')
         _check_frame(frame)
-        self.wait_learned()
         center, size, angle, anchor = (
             self._center.copy(),
             self._size.copy(),
@@ -279,12 +278,25 @@ class IemdTracker:
             center, size, turn = _apply_prior(prior, center, size)
             angle = _wrap_angle(angle + turn)
             anchor = None if anchor is None else _apply_prior(prior, anchor, size)[0]
+        cfg = self.config
+        # what needs no model (grey levels, pyramid, flow, the filter's sample) runs while the
+        # models still learn from the last frame
+        grey, pyramid = self._take_frame(frame)
+        visible = _visible_fraction(center, size, angle, frame.shape)
+        flow = region = None
+        if visible >= cfg.min_visible:
+            if cfg.flow_start:
+                box = _box(self._center, self._size, self._angle)
+                flow = _workers().submit(
+                    window_flow, self._previous, grey, box, prior, cfg.flow_max_error
+                )
+            if self._translation_filter is not None:
+                region = self._translation_filter.sample(frame, center, size, angle)
+        self.wait_learned()
+        self._previous = grey if cfg.flow_start else None
         self._frame_index += 1
         self._anchor, self._prediction = anchor, center
         predicted = _box(center, size, angle)
-        previous, grey, pyramid = self._take_frame(frame)
-        visible = _visible_fraction(center, size, angle, frame.shape)
-        cfg = self.config
         # the prior moved the window out of view: keep its place, search only the frame
         if visible < cfg.min_visible:
             redetected = (
@@ -301,7 +313,7 @@ class IemdTracker:
                 f'only {visible:.0%} of the predicted window is inside the image',
             )
         best, searches, starts = self._search_all(
-            frame, previous, grey, pyramid, prior, center, size, angle
+            frame, flow, region, pyramid, center, size, angle
         )
         # held or lost: the window keeps its size
         final, scale = _Descent(model=best.model, emd=best.emd), 1.0
@@ -488,28 +500,23 @@ class IemdTracker:
     def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float]:
         """(centre, value) of the translation filter's peak in its search region around ``at``."""
         tf = self._translation_filter
-        return at + tf.estimate(frame, at, size, angle), tf.response_peak
+        return at + tf.estimate(tf.sample(frame, at, size, angle)), tf.response_peak
 
-    def _search_all(self, frame, previous, grey, pyramid, prior, center, size, angle):
+    def _search_all(self, frame, flow, region, pyramid, center, size, angle):
         """
         (best descent, every search run, starts searched) from the prediction ``center``.
 
-        The fine starts (flow, translation filter, colour model) and, when the frame looks lost,
-        section 6.1's particles.
+        The fine starts (the flow's, a Future or None; the translation filter's on its sampled
+        ``region``; the colour model's) and, when the frame looks lost, section 6.1's particles.
         """
         cfg = self.config
-        # Where the flow, the translation filter and the colour model take the window: independent,
-        # so the flow and the colour model run on the worker threads while the filter runs here.
+        # Where the translation filter and the colour model take the window: independent, so the
+        # colour model runs on a worker thread (beside the flow) while the filter runs here.
         self._colour_now = self._colour_model is not None and frame.ndim == 3
-        pool = _workers()
-        flow = colour = None
-        if cfg.flow_start:
-            box = _box(self._center, self._size, self._angle)
-            flow = pool.submit(window_flow, previous, grey, box, prior, cfg.flow_max_error)
+        colour = None
         if self._colour_now:
-            colour = pool.submit(self._colour_model.estimate, frame, center, size, angle)
-        tf = self._translation_filter
-        filter_move = tf.estimate(frame, center, size, angle) if tf is not None else None
+            colour = _workers().submit(self._colour_model.estimate, frame, center, size, angle)
+        filter_move = None if region is None else self._translation_filter.estimate(region)
         # the prediction's window is coded and solved here while the workers run
         context = self._context(pyramid, angle)
         predicted = CandidateModel(context, center, size)
@@ -597,15 +604,13 @@ class IemdTracker:
 
     def _take_frame(self, frame: np.ndarray):
         """
-        (grey levels kept from the previous frame, ``frame``'s grey levels, its pyramid).
+        (``frame``'s grey levels, its pyramid).
 
-        With the flow start the grey levels are kept for the next frame, copied (the caller may
-        reuse its buffer); without it nothing is kept (None).
+        With the flow start the grey levels are a copy, kept for the next frame (the caller may
+        reuse its buffer).
         """
-        keep = self.config.flow_start
-        grey = grey_levels(frame, copy=keep)
-        previous, self._previous = self._previous, (grey if keep else None)
-        return previous, grey, ImagePyramid(to_gray(grey))
+        grey = grey_levels(frame, copy=self.config.flow_start)
+        return grey, ImagePyramid(to_gray(grey))
 
     def _confidence_check(self, center) -> tuple[float | None, str]:
         """

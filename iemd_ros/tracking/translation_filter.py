@@ -57,6 +57,8 @@ complementary view (docs/decisions.md#strcf).
 """
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from iemd_ros.tracking import features
 from iemd_ros.tracking.appearance import window_axes
 from iemd_ros.tracking.correlation_filter import (
@@ -72,7 +74,7 @@ import numba
 import numpy as np
 import scipy.fft as sfft
 
-__all__ = ['TranslationFilter', 'SEARCH_AREA_SCALE']
+__all__ = ['Region', 'TranslationFilter', 'SEARCH_AREA_SCALE']
 
 SEARCH_AREA_SCALE = 5.0                       # side of the search region / sqrt(w h) (STRCF, BACF)
 SAMPLE_AREA = (150.0 ** 2, 160.0 ** 2)        # area bounds of the resampled region, px^2
@@ -82,6 +84,17 @@ MU = 15.0                                     # STRCF's temporal regularization
 ADMM_ITERATIONS = 2
 GAMMA_INIT, GAMMA_STEP, GAMMA_MAX = 1.0, 10.0, 0.1  # ADMM penalty schedule (STRCF)
 FRAME_SEARCH_CELLS = 2048  # feature cells searched per search_frame call (its cost per lost frame)
+
+
+class Region(NamedTuple):
+    """The search region's spectrum and where it was taken (:meth:`TranslationFilter.sample`)."""
+
+    frame_id: int        # id() of the frame sampled
+    center: np.ndarray   # the predicted window's centre, image px
+    pos: np.ndarray      # the region's centre, image px
+    scale: float         # image px per sample px
+    angle: float         # the region's turn, radians
+    zf: np.ndarray       # (C, n, n // 2 + 1) spectrum of the windowed features
 
 
 class TranslationFilter:
@@ -143,11 +156,12 @@ class TranslationFilter:
         self.update(frame, center, size, angle)
 
     # ------------------------------------------------------------------ detection
-    def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
+    def sample(self, frame: np.ndarray, center, size, angle: float = 0.0) -> Region:
         """
-        Displacement (dx, dy) px from ``center`` to where the current filter's response peaks.
+        Return the spectrum of the search region around a predicted window, for :meth:`estimate`.
 
-        The response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
+        It reads only the geometry fixed by :meth:`init`, not the filter, so it may run while
+        :meth:`update` learns.
 
         Parameters
         ----------
@@ -160,26 +174,48 @@ class TranslationFilter:
 
         Returns
         -------
-        ndarray
-            (2,) displacement, image px.
+        Region
+            The region's features' spectrum and where it was taken.
 
         """
         scale = self._scale(size)
         pos = self._position(center, angle)
-        zf = self._spectrum(frame, pos, scale, angle)
-        rf = np.empty(zf.shape[1:], np.complex64)
-        correlate(self.f, zf, rf)
+        return Region(
+            id(frame),
+            np.asarray(center, dtype=np.float64),
+            pos,
+            scale,
+            angle,
+            self._spectrum(frame, pos, scale, angle),
+        )
+
+    def estimate(self, region: Region) -> np.ndarray:
+        """
+        Displacement (dx, dy) px from the region's window centre to where the response peaks.
+
+        The response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
+
+        Parameters
+        ----------
+        region : Region
+            :meth:`sample` of the frame around the predicted window.
+
+        Returns
+        -------
+        ndarray
+            (2,) displacement, image px.
+
+        """
+        rf = np.empty(region.zf.shape[1:], np.complex64)
+        correlate(self.f, region.zf, rf)
         resp = sfft.irfft2(rf, s=self.map_hw)
         dy, dx, value = self.peak(resp, rf)
-        cell_px = features.CELL * scale
-        self._detection = (id(frame), pos, scale, angle, zf)
-        self._response = (resp, pos, cell_px, window_axes(angle))
+        cell_px = features.CELL * region.scale
+        axes = window_axes(region.angle)
+        self._detection = region
+        self._response = (resp, region.pos, cell_px, axes)
         self.response_peak = value
-        return (
-            window_axes(angle) @ (np.array([dx, dy]) * cell_px)
-            + pos
-            - np.asarray(center, dtype=np.float64)
-        )
+        return axes @ (np.array([dx, dy]) * cell_px) + region.pos - region.center
 
     def response_at(self, point) -> float:
         """
@@ -291,19 +327,18 @@ class TranslationFilter:
         det, self._detection = self._detection, None
         if (
             det is not None
-            and det[0] == id(frame)
-            and abs(det[2] / scale - 1.0) < 0.05
-            and det[3] == angle
+            and det.frame_id == id(frame)
+            and abs(det.scale / scale - 1.0) < 0.05
+            and det.angle == angle
         ):
-            _, pos, det_scale, _, zf = det
             shift = (
                 window_axes(angle).T
-                @ (np.asarray(center, dtype=np.float64) - pos)
-                / (features.CELL * det_scale)
+                @ (np.asarray(center, dtype=np.float64) - det.pos)
+                / (features.CELL * det.scale)
             )
             phase_y = np.exp(2j * np.pi * self.ky * shift[1] / self.map_hw[0]).astype(np.complex64)
             phase_x = np.exp(2j * np.pi * self.kx * shift[0] / self.map_hw[1]).astype(np.complex64)
-            xf = zf * (phase_y[:, None] * phase_x[None, :])[None]
+            xf = det.zf * (phase_y[:, None] * phase_x[None, :])[None]
         else:
             xf = self._spectrum(frame, self._position(center, angle), scale, angle)
         self.f = self._admm(xf, self.f)
