@@ -431,7 +431,7 @@ class PatchLayout:
         return image.ravel()[self._patch_index]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _patch_mean(flat, pixels):
     total = 0.0
     for j in range(pixels.size):
@@ -439,7 +439,7 @@ def _patch_mean(flat, pixels):
     return total / pixels.size
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _unit_patches(flat, gx, gy, index, floor, jacobian):
     """
     Patches of a flat template brought to zero mean and unit norm, and their Jacobian.
@@ -478,7 +478,7 @@ def _unit_patches(flat, gx, gy, index, floor, jacobian):
     return eps, jac
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _gradient(image):
     """
     (d/dx, d/dy) of a 2-D image as ``np.gradient``.

@@ -355,7 +355,7 @@ class CandidateModel:
         raise ValueError(f'unknown gradient {kind!r}')
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _transport_cost(appearance_cost, keep, target_pos, pos, y, spatial_weight):
     """
     d_uv over the kept candidate bins.
@@ -372,7 +372,7 @@ def _transport_cost(appearance_cost, keep, target_pos, pos, y, spatial_weight):
     return cost
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _appearance_contraction(transported, received, keep, eps, eps_jacobian):
     """
     sum_v (sum_u f_uv eps_u - w_v eps_v) . d eps_v/dy over the kept bins v.

@@ -119,7 +119,7 @@ def candidate_weights(code_weights, pos, y, bandwidth):
     )
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _candidate_weights(code_weights, pos, y, bandwidth):
     """One pass of :func:`candidate_weights` (it runs on every EMD evaluation)."""
     n = pos.shape[0]

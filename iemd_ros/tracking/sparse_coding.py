@@ -46,7 +46,7 @@ import numba
 import numpy as np
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _factor_append(chol, order, k, j, gram, ridge):
     """
     Extend the lower Cholesky factor of G[order[:k], order[:k]] + ridge I by atom j.
@@ -64,7 +64,7 @@ def _factor_append(chol, order, k, j, gram, ridge):
     chol[k, k] = np.sqrt(max(d, 1e-12))
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _factor_solve(chol, order, k, b, z):
     """Solve for z = (L L')^-1 b[order[:k]] (forward then back substitution)."""
     for i in range(k):
@@ -79,7 +79,7 @@ def _factor_solve(chol, order, k, b, z):
         z[i] = v / chol[i, i]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, nogil=True)
 def _active_set_lasso(gram, correlations, lam, tol, ridge):
     """
     Exact non-negative lasso for every column of ``correlations`` (= Phi' E).
