@@ -890,6 +890,11 @@ def _visible_fraction(center, size, angle: float, shape) -> float:
     centred at ``center + 0.5`` (pixel centres at integers, as ``centre_box``).
     """
     h_img, w_img = shape[:2]
+    if angle == 0.0:  # the overlap of two axis-aligned rectangles
+        lo = np.asarray(center, dtype=np.float64) + 0.5 - np.asarray(size) / 2.0
+        hi = lo + np.asarray(size)
+        overlap = np.clip(np.minimum(hi, (w_img, h_img)) - np.maximum(lo, 0.0), 0.0, None)
+        return float(overlap[0] * overlap[1]) / float(size[0] * size[1])
     corners = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]) * (
         np.asarray(size) / 2.0
     )

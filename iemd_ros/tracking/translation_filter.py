@@ -394,7 +394,7 @@ class TranslationFilter:
                 break
             a = g_now * f + (zeros if h is None else h)
             gs = sfft.irfft2(a, s=self.map_hw) * (1.0 / (self.reg_sq + g_now)).astype(rdt)[None]
-            g = sfft.rfft2(gs).astype(cdt)
+            g = sfft.rfft2(gs).astype(cdt, copy=False)
             h = np.zeros(shape, cdt) if h is None else h
             h += g_now * (f - g)
             g_now = min(g_step * g_now, g_max)
@@ -426,7 +426,7 @@ class TranslationFilter:
         patch = sample_region(frame, pos, (side, side), (self.support, self.support), angle)
         x = features.extract(patch, self.colour)
         x *= self.window[None]
-        return sfft.rfft2(x).astype(np.complex64)
+        return sfft.rfft2(x).astype(np.complex64, copy=False)
 
 
 def _bilinear_circular(resp: np.ndarray, y: float, x: float) -> float:
