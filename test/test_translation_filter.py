@@ -119,6 +119,26 @@ def test_update_learns_the_tracked_window(car4_first):
     assert np.linalg.norm(again - (np.round(new_centre) - new_centre)) < 1.0
 
 
+def test_a_region_sampled_before_the_filter_learns_estimates_as_one_sampled_after(car4_first):
+    """
+    The tracker samples the next frame's region while the filter still learns from the last one.
+
+    So :meth:`TranslationFilter.sample` must not read the filter: a region sampled before an
+    update holds the same spectrum as one sampled after it, and the updated filter estimates the
+    same move on both.
+    """
+    frame, box = car4_first
+    centre, size = box_centre(box), box[2:]
+    tf = _learned(frame, box)
+    moved = shifted(frame, 5.0, -3.0)
+    before = tf.sample(moved, centre, size)
+    tf.update(shifted(frame, 1.0, 1.0), centre, size)  # a learning step changes the filter
+    after = tf.sample(moved, centre, size)
+    assert np.array_equal(before.zf, after.zf)
+    assert np.array_equal(tf.estimate(before), tf.estimate(after))
+    assert np.linalg.norm(tf.estimate(after) - (5.0, -3.0)) < 1.5
+
+
 def test_the_tracker_adds_the_filter_start_and_follows_a_shift(car4_first):
     """
     Car4's frame moved by (9, -6).
