@@ -366,37 +366,38 @@ class TranslationFilter:
         g_now, g_step, g_max = gamma
         shape, cdt = xf.shape, xf.dtype
         rdt = np.float32 if cdt == np.complex64 else np.float64
-        zeros = np.zeros(shape, cdt)
         S = np.empty(shape[1:], rdt)
         energy(xf, S)
-        yfc = self.yf_conj.astype(cdt)
+        yfc = self.yf_conj.astype(cdt, copy=False)
         g = h = None
         f = np.empty(shape, cdt)
         xq = np.empty(shape[1:], cdt)
         for it in range(iterations):
             kap = g_now + mu
             dinv = (1.0 / (self.T * kap + S)).astype(rdt)
+            # g and h are 0 before the first g-step: their terms drop out of q
             _f_step(
                 xf,
                 yfc,
                 dinv,
-                zeros if g is None else g,
-                zeros if h is None else h,
-                zeros if f_prev is None else f_prev,
+                f if g is None else g,
+                f if h is None else h,
+                f if f_prev is None else f_prev,
                 rdt(0.0 if g is None else g_now / kap),
                 rdt(0.0 if h is None else 1.0 / kap),
                 rdt(mu / kap),
-                g is not None or h is not None or mu > 0,
+                g is not None,
+                mu > 0,
                 f,
                 xq,
             )
             if it == iterations - 1:
                 break
-            a = g_now * f + (zeros if h is None else h)
+            a = g_now * f if h is None else g_now * f + h
             gs = sfft.irfft2(a, s=self.map_hw) * (1.0 / (self.reg_sq + g_now)).astype(rdt)[None]
             g = sfft.rfft2(gs).astype(cdt, copy=False)
-            h = np.zeros(shape, cdt) if h is None else h
-            h += g_now * (f - g)
+            step = g_now * (f - g)
+            h = step if h is None else h + step
             g_now = min(g_step * g_now, g_max)
         return f
 
@@ -442,14 +443,16 @@ def _bilinear_circular(resp: np.ndarray, y: float, x: float) -> float:
 
 
 @numba.njit(cache=True, fastmath=True, nogil=True)
-def _f_step(xf, yfc, dinv, g, h, fp, cg, ch, cp, use_q, out, xq):
+def _f_step(xf, yfc, dinv, g, h, fp, cg, ch, cp, use_gh, use_fp, out, xq):
     """
     Compute STRCF's f-step (eq. 8) per frequency.
 
-    ``q = cg g - ch h + cp fp``, ``f = q + x (conj(y) - x^H q) dinv``.
+    ``q = cg g - ch h + cp fp`` (the g and h terms only with ``use_gh``, the fp term only with
+    ``use_fp``), ``f = q + x (conj(y) - x^H q) dinv``.  ``out`` may be passed as an unused ``g``,
+    ``h`` or ``fp``: those are not read.
     """
     C, H, W = xf.shape
-    if not use_q:
+    if not use_gh and not use_fp:
         for d in range(C):
             for i in range(H):
                 for j in range(W):
@@ -459,7 +462,12 @@ def _f_step(xf, yfc, dinv, g, h, fp, cg, ch, cp, use_q, out, xq):
     for d in range(C):
         for i in range(H):
             for j in range(W):
-                q = cg * g[d, i, j] - ch * h[d, i, j] + cp * fp[d, i, j]
+                if use_gh and use_fp:
+                    q = cg * g[d, i, j] - ch * h[d, i, j] + cp * fp[d, i, j]
+                elif use_gh:
+                    q = cg * g[d, i, j] - ch * h[d, i, j]
+                else:
+                    q = cp * fp[d, i, j]
                 out[d, i, j] = q
                 xq[i, j] += np.conj(xf[d, i, j]) * q
     for i in range(H):
