@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import cv2
 from iemd_ros.tracking.appearance import warp_window, window_axes
+import numba
 import numpy as np
 
 
@@ -261,8 +262,21 @@ class ColourModel:
         sample = warp_window(
             frame, center, window_axes(angle) / scale, out_size, cv2.INTER_NEAREST
         )
-        q = (sample >> self._shift).astype(np.intp)
-        return (q[..., 0] * self.bins + q[..., 1]) * self.bins + q[..., 2], scale
+        return _bin_index(sample, self._shift, self.bins), scale
+
+
+@numba.njit(cache=True, nogil=True)
+def _bin_index(sample, shift, bins):
+    """Histogram bin of every pixel of an (h, w, 3) uint8 sample: its levels >> ``shift``."""
+    h, w = sample.shape[:2]
+    out = np.empty((h, w), np.intp)
+    for y in range(h):
+        for x in range(w):
+            b0 = np.intp(sample[y, x, 0]) >> shift
+            b1 = np.intp(sample[y, x, 1]) >> shift
+            b2 = np.intp(sample[y, x, 2]) >> shift
+            out[y, x] = (b0 * bins + b1) * bins + b2
+    return out
 
 
 def _beta(target: np.ndarray, surroundings: np.ndarray) -> np.ndarray:
