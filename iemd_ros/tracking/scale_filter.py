@@ -181,20 +181,23 @@ class ScaleFilter:
             if angle == 0.0
             else (pos[0] - sw / 2, pos[1] - sh / 2)
         )
+        # each scale's box (pw, ph) at its corner (x0k, y0k), and the warp of the region onto it
+        pw = np.maximum(np.floor(tw * self.size_factors), 1.0)
+        ph = np.maximum(np.floor(th * self.size_factors), 1.0)
+        if angle == 0.0:
+            x0k, y0k = pos[0] - pw.astype(int) // 2, pos[1] - ph.astype(int) // 2
+        else:
+            x0k, y0k = pos[0] - pw / 2, pos[1] - ph / 2
+        warps = np.zeros((N_SCALES, 2, 3))
+        warps[:, 0, 0], warps[:, 0, 2] = pw / mw * ax, ((x0k - x0) + 0.5 * pw / mw) * ax - 0.5
+        warps[:, 1, 1], warps[:, 1, 2] = ph / mh * ay, ((y0k - y0) + 0.5 * ph / mh) * ay - 0.5
         patches = np.empty((N_SCALES, mh, mw) + region.shape[2:], region.dtype)
-        M = np.zeros((2, 3))
-        for k, s in enumerate(self.size_factors):
-            pw, ph = max(np.floor(tw * s), 1.0), max(np.floor(th * s), 1.0)
-            if angle == 0.0:
-                x0k, y0k = pos[0] - int(pw) // 2, pos[1] - int(ph) // 2
-            else:
-                x0k, y0k = pos[0] - pw / 2, pos[1] - ph / 2
-            M[0, 0], M[0, 2] = pw / mw * ax, ((x0k - x0) + 0.5 * pw / mw) * ax - 0.5
-            M[1, 1], M[1, 2] = ph / mh * ay, ((y0k - y0) + 0.5 * ph / mh) * ay - 0.5
-            patches[k] = cv2.warpAffine(
+        for k in range(N_SCALES):
+            cv2.warpAffine(
                 region,
-                M,
+                warps[k],
                 (mw, mh),
+                dst=patches[k],
                 flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
                 borderMode=cv2.BORDER_REPLICATE,
             )
