@@ -48,11 +48,10 @@ ms/frame, and the time of everything else in the replay (its own overhead, which
 
 With ``--whole N`` it measures instead the whole ``iemd-replay`` process (Python start-up, imports,
 numba's cache, the bag's opening, the replay, the CSV: wall clock from the start of the process to
-its exit) on the bag with the gyro, N runs of each command in turn (A B C A B C ...: the machine's
-drift hits them alike): this tree, this tree with ``--read-ahead 0`` (decoding on the tracker's
-thread, the serial loop), and with ``--baseline TREE`` another checkout of iemd_ros (e.g. a ``git
-worktree`` of an older commit) run by the same Python; each run's × real time is printed, then the
-medians.  ``--bag`` replays an existing bag instead of making one.
+its exit) on the bag with the gyro, N runs of each command in turn (A B A B ...: the machine's
+drift hits them alike): this tree and, with ``--baseline TREE``, another checkout of iemd_ros
+(e.g. a ``git worktree`` of an older commit) run by the same Python; each run's × real time is
+printed, then the medians.  ``--bag`` replays an existing bag instead of making one.
 
     PYTHONPATH=. .venv/bin/python benchmarks/replay_speed.py [--frames N] [--no-gyro-too]
                                                              [--compress C ...] [--keep DIR]
@@ -132,7 +131,6 @@ def whole_runs(bag: Path, runs: int, baseline: Path | None, folder: Path) -> Non
     """
     commands = {
         'this tree': (ROOT, []),
-        'this tree, --read-ahead 0': (ROOT, ['--read-ahead', '0']),
     }
     if baseline is not None:
         commands[f'{baseline}'] = (baseline.resolve(), [])

@@ -39,7 +39,6 @@ import re
 import shutil
 import subprocess
 import sys
-import threading
 
 from bag_fixtures import (
     by_topic,
@@ -62,7 +61,7 @@ from helpers import (
     run_module,
 )
 from iemd_ros.apps.replay import main
-from iemd_ros.bags.io import BagWriter, COMPRESSED_IMAGE_TYPE, IMAGE_TYPE, open_bag
+from iemd_ros.bags.io import BagWriter, COMPRESSED_IMAGE_TYPE, IMAGE_TYPE
 from iemd_ros.bags.make import (
     _camera_info_msg,
     _compressed_msg,
@@ -79,13 +78,10 @@ from iemd_ros.bags.replay import (
     DETECTIONS_TOPIC,
     DIAGNOSTICS_TOPIC,
     parse_box,
-    READ_AHEAD,
-    read_ahead,
     replay,
 )
 from iemd_ros.common.cli import split_ros_args
 from iemd_ros.evaluation.metrics import iou, score_sequence
-from iemd_ros.messages.conversions import stamp_ns
 from iemd_ros.pipeline import Rejection
 import numpy as np
 import pytest
@@ -192,97 +188,6 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     )
     ok, frame = cap.read()
     assert ok and frame.shape == (240, 320, 3)
-
-
-# the diagnostics values measured on the wall clock (the tracker's update times): they differ from
-# run to run, the serial replay's as well
-WALL_CLOCK_VALUES = ('processing_ms_mean', 'processing_ms_max')
-
-
-def _raw_by_topic(path) -> dict[str, list[tuple[int, bytes]]]:
-    reader = open_bag(path)
-    try:
-        out: dict[str, list[tuple[int, bytes]]] = {}
-        for c, t, raw in reader.messages():
-            out.setdefault(c.topic, []).append((t, bytes(raw)))
-        return out
-    finally:
-        reader.close()
-
-
-def _diagnostics_but_wall_clock(path) -> list:
-    return [
-        (
-            stamp_ns(m.header),
-            [
-                (
-                    s.level,
-                    s.name,
-                    s.message,
-                    s.hardware_id,
-                    [(v.key, '' if v.key in WALL_CLOCK_VALUES else v.value) for v in s.values],
-                )
-                for s in m.status
-            ],
-        )
-        for m in by_topic(read_all(path), DIAGNOSTICS_TOPIC)
-    ]
-
-
-@pytest.mark.parametrize('depth', [1, 3, READ_AHEAD])
-def test_read_ahead_replays_as_the_serial_loop(seq, bags, tmp_path, depth):
-    """
-    Decoding ahead on a thread gives the serial replay's CSV byte for byte.
-
-    The same detection and annotation messages byte for byte, and the same diagnostics and debug
-    images but for the update times measured on the wall clock.
-    """
-    init = _init(seq)
-    serial = replay(
-        bags / 'shaky', init, csv_path=tmp_path / 's.csv', out_bag=tmp_path / 's_out', read_ahead=0
-    )
-    ahead = replay(
-        bags / 'shaky',
-        init,
-        csv_path=tmp_path / 'a.csv',
-        out_bag=tmp_path / 'a_out',
-        read_ahead=depth,
-    )
-    assert (tmp_path / 'a.csv').read_bytes() == (tmp_path / 's.csv').read_bytes()
-    assert [r.box for r in ahead.results] == [r.box for r in serial.results] and len(
-        serial.results
-    ) == N
-    s, a = _raw_by_topic(tmp_path / 's_out'), _raw_by_topic(tmp_path / 'a_out')
-    assert a[DETECTIONS_TOPIC] == s[DETECTIONS_TOPIC] and len(s[DETECTIONS_TOPIC]) == N
-    assert a[ANNOTATIONS_TOPIC] == s[ANNOTATIONS_TOPIC]
-    # the debug image prints the update's wall-clock ms on the frame, so its JPEG differs between
-    # serial runs too
-    assert [t for t, _ in a[DEBUG_IMAGE_TOPIC]] == [t for t, _ in s[DEBUG_IMAGE_TOPIC]]
-    assert [t for t, _ in a[DIAGNOSTICS_TOPIC]] == [t for t, _ in s[DIAGNOSTICS_TOPIC]]
-    assert _diagnostics_but_wall_clock(tmp_path / 'a_out') == _diagnostics_but_wall_clock(
-        tmp_path / 's_out'
-    )
-    assert ahead.diagnostics['gyro_used'] == serial.diagnostics['gyro_used'] > 0
-
-
-def test_read_ahead_keeps_the_order_raises_in_place_and_stops_its_thread():
-    def items(n, fail_at=None):
-        for i in range(n):
-            if i == fail_at:
-                raise ValueError(f'item {i}')
-            yield i
-
-    assert list(read_ahead(items(100), 2)) == list(range(100))
-    got = []
-    with pytest.raises(ValueError, match='item 7'):
-        for i in read_ahead(items(100, fail_at=7), 3):
-            got.append(i)
-    assert got == list(range(7))  # everything before the error, as the serial loop
-    before = threading.active_count()
-    it = read_ahead(items(10**9), 4)
-    assert next(it) == 0
-    it.close()  # the consumer leaves early: the thread stops
-    assert threading.active_count() == before
 
 
 def test_png_bag_replays_like_raw(seq, bags, tmp_path, capsys):

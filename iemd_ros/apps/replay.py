@@ -34,7 +34,7 @@ Also ``ros2 run iemd_ros replay``.
 
     iemd-replay BAG --init X,Y,W,H [--image-topic T] [--imu-topic T] [--camera-info-topic T]
                 [--no-gyro] --csv OUT.csv [--out-bag DIR] [--video OUT.mp4] [--gt FILE]
-                [--config YAML] [--camera-yaml FILE] [--time-offset-ms MS] [--read-ahead N]
+                [--config YAML] [--camera-yaml FILE] [--time-offset-ms MS]
                 [--progress | --no-progress]
     iemd-replay BAG_OR_FOLDER [...] --init X,Y,W,H [--init ...] --out-dir DIR [--out-bags]
                 [--jobs N | --cluster tcp://HOST:8786] [the topic, gyro and config options]
@@ -66,7 +66,7 @@ from iemd_ros.bags.batch import (
     replay_jobs,
     RESULT_BAG_SUFFIX,
 )
-from iemd_ros.bags.replay import CSV_HEADER, parse_box, READ_AHEAD, replay, ReplayResult
+from iemd_ros.bags.replay import CSV_HEADER, parse_box, replay, ReplayResult
 from iemd_ros.common.cli import cli_main, CliParser, split_ros_args
 from iemd_ros.common.parallel import add_worker_arguments, Workers
 from iemd_ros.datasets.otb import parse_groundtruth
@@ -171,15 +171,6 @@ def build_parser() -> argparse.ArgumentParser:
         type=float,
         default=None,
         help='gyro time offset t_d (t_imu = t_cam + t_d); default from --config, else 0',
-    )
-    p.add_argument(
-        '--read-ahead',
-        type=int,
-        default=READ_AHEAD,
-        metavar='N',
-        help='messages read and decoded ahead of the tracker on a second thread (default '
-        f'{READ_AHEAD}; '
-        "0: on the tracker's thread); the results are the same",
     )
     p.add_argument(
         '--progress',
@@ -316,10 +307,6 @@ def main(argv: list[str] | None = None) -> int:
             'use_gyro': not a.no_gyro,
             'camera': camera,
         }
-        if a.read_ahead < 0:
-            raise ValueError(f'--read-ahead {a.read_ahead}: give 0 or more messages')
-        if a.read_ahead != READ_AHEAD:
-            options['read_ahead'] = a.read_ahead
         return _one_bag(a, options) if a.out_dir is None else _batch(a, options)
 
     return cli_main('iemd-replay', body)

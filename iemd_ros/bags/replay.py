@@ -62,9 +62,7 @@ import csv
 from dataclasses import dataclass, field, replace
 import math
 from pathlib import Path
-import queue
 import sys
-import threading
 import time
 
 import cv2
@@ -110,9 +108,7 @@ __all__ = [
     'replay',
     'parse_box',
     'write_csv',
-    'read_ahead',
     'CSV_HEADER',
-    'READ_AHEAD',
     'DETECTIONS_TOPIC',
     'DIAGNOSTICS_TOPIC',
     'ANNOTATIONS_TOPIC',
@@ -372,74 +368,6 @@ class _Video:
 # ----------------------------------------------------------------------------------------------
 # replay kinds of _messages' items
 _IMAGE, _IMU, _CAMERA, _BAD_CAMERA = 'image', 'imu', 'camera', 'bad camera'
-# messages decoded ahead of the tracker (about 9 frames of a 30 Hz camera with a 100 Hz IMU)
-READ_AHEAD = 64
-_END = object()
-
-
-def read_ahead(items, depth: int = READ_AHEAD):
-    """
-    Yield the items of the iterator ``items``.
-
-    Produced on a thread of its own up to ``depth`` ahead of the consumer.
-
-    The thread reads, decodes and converts (file reads, memory copies, OpenCV's image decoding)
-    while the caller's thread tracks, so a second core is used; the items come in the same order,
-    and an exception raised by ``items`` is raised here where the serial loop would have met it.
-    Closing the generator (or leaving the loop) stops the thread and waits for it, so the reader it
-    uses may be closed then.
-
-    Parameters
-    ----------
-    items : iterator
-        Produces the items (a generator; it must not touch what the consumer changes).
-    depth : int, optional
-        The most items produced ahead (> 0).
-
-    Yields
-    ------
-    object
-        The items of ``items``, in order.
-
-    """
-    q: queue.Queue = queue.Queue(maxsize=max(int(depth), 1))
-    stop = threading.Event()
-
-    def put(entry) -> bool:
-        while not stop.is_set():
-            try:
-                q.put(entry, timeout=0.1)
-                return True
-            except queue.Full:
-                continue
-        return False
-
-    def produce() -> None:
-        try:
-            for item in items:
-                if not put((item, None)):
-                    return
-            put((_END, None))
-        except BaseException as exc:  # handed to the consumer, raised there in order
-            put((_END, exc))
-        finally:
-            close = getattr(items, 'close', None)
-            if close is not None:
-                close()
-
-    thread = threading.Thread(target=produce, name='iemd_replay_read_ahead', daemon=True)
-    thread.start()
-    try:
-        while True:
-            item, error = q.get()
-            if item is _END:
-                if error is not None:
-                    raise error
-                return
-            yield item
-    finally:
-        stop.set()
-        thread.join()
 
 
 @dataclass
@@ -477,10 +405,6 @@ class Replay:
         Images with these stamps are skipped and counted as dropped
         (``TrackingPipeline.note_dropped``), as the live node does with frames that arrive while it
         is busy: a live run reproduced offline.
-    read_ahead : int, optional
-        Messages read, decoded and converted ahead of the tracker on a thread of their own
-        (:func:`read_ahead`; default :data:`READ_AHEAD`); 0 does it all on the caller's thread, as
-        the replay did before.  The results are the same either way.
 
     Raises
     ------
@@ -503,7 +427,6 @@ class Replay:
         camera: CameraModel | None = None,
         warn=None,
         drop_stamps=(),
-        read_ahead: int = READ_AHEAD,
     ):
         self.bag = bag
         self.init_box = parse_box(init_box)
@@ -515,7 +438,6 @@ class Replay:
         self.warnings: list[str] = []
         self._camera = camera
         self._drop = {int(t) for t in drop_stamps}
-        self.read_ahead = max(int(read_ahead), 0)
         self._reader = open_bag(bag, warn=self._note)
         try:
             self.topics = select_topics(self._reader, image_topic, imu_topic, camera_info_topic)
@@ -640,8 +562,6 @@ class Replay:
         Before each, the held frames whose IMU wait ended earlier go.
         """
         messages = self._messages()
-        if self.read_ahead:
-            messages = read_ahead(messages, self.read_ahead)
         try:
             for kind, log_t, item in messages:
                 self._release(log_t)
@@ -666,8 +586,7 @@ class Replay:
 
         read, decoded and converted (an image into its :class:`_Frame`, an IMU message into the
         arguments of ``add_imu_message``, a camera info into its CameraModel or, refused, the
-        reason); nothing here touches the pipeline, so this may run ahead on a thread of its own
-        (:func:`read_ahead`).
+        reason); nothing here touches the pipeline.
         """
         t = self.topics
         wanted = (
