@@ -318,6 +318,23 @@ def test_visible_fraction_of_a_turned_window():
     assert _visible_fraction((400.0, 100.0), (20.0, 20.0), 0.3, shape) == 0.0
 
 
+def test_an_unturned_windows_visible_fraction_is_the_turned_formulas_at_no_turn():
+    """
+    An unturned window's share is the overlap of two rectangles, the turned one's a convex clip.
+
+    Both agree (to the convex clip's float32) on windows inside, across every border and corner,
+    larger than the image and outside it.
+    """
+    shape = (240, 320)
+    rng = np.random.default_rng(3)
+    centres = rng.uniform((-60.0, -60.0), (380.0, 300.0), (200, 2))
+    sizes = rng.uniform(4.0, 400.0, (200, 2))
+    for centre, size in zip(centres, sizes):
+        assert _visible_fraction(centre, size, 0.0, shape) == pytest.approx(
+            _visible_fraction(centre, size, 1e-9, shape), abs=1e-4
+        ), (centre, size)
+
+
 def test_reconstructed_template_removes_an_occluder():
     """Eq. (reconstructed template): occluded pixels go to the trivial templates."""
     layout = PatchLayout((32, 32), (8, 8), 4)
