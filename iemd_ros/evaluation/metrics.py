@@ -562,8 +562,10 @@ def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) ->
     if resamples < 1:
         raise ValueError(f'resamples must be >= 1, got {resamples}')
     diff = a - b
+    # every sequence has as many starts: a draw's mean is the mean of its sequences' means
+    per_sequence = diff.mean(axis=1)
     rows = np.random.default_rng(seed).integers(0, len(diff), size=(resamples, len(diff)))
-    means = diff[rows].mean(axis=(1, 2))
+    means = per_sequence[rows].mean(axis=1)
     low, high = np.percentile(means, [2.5, 97.5])
     return PairedDifference(
         mean=float(diff.mean()),
