@@ -43,6 +43,8 @@ from iemd_ros.datasets.otb import load_sequence, Sequence
 from iemd_ros.evaluation.metrics import long_term_scores, REACQUIRE_WITHIN
 from iemd_ros.evaluation.split import in_part
 from iemd_ros.tracking import IemdTracker
+from iemd_ros.tracking import tracker as tracker_module
+from iemd_ros.tracking.tracker import Cause
 import numpy as np
 import pytest
 
@@ -152,6 +154,16 @@ def test_eval_reports_the_long_term_measures_of_a_look_away_sequence(tmp_path, c
     assert doc['long_term']['kcf']['n_sequences'] == 1 and REACQUIRE_WITHIN == 30
 
 
+def _track_cut(seq):
+    """(boxes, found flags, results) of the default tracker over a look-away cut from its GT."""
+    frames = [cv2.imread(str(path)) for path in seq.frame_paths]
+    tracker = IemdTracker()
+    tracker.init(frames[0], seq.gt_boxes[0])
+    results = [tracker.update(frame) for frame in frames[1:]]
+    boxes = np.vstack([seq.gt_boxes[0]] + [np.asarray(r.box, float) for r in results])
+    return boxes, np.array([True] + [not r.lost for r in results]), results
+
+
 def test_the_tracker_says_lost_while_a_real_target_is_away_and_finds_it_on_return(
     tmp_path, uav_root
 ):
@@ -165,19 +177,42 @@ def test_the_tracker_says_lost_while_a_real_target_is_away_and_finds_it_on_retur
     seq = load_sequence(
         write_look_away(load_sequence(uav_root / 'building5'), tmp_path / 'la', LookAway())
     )
-    frames = [cv2.imread(str(path)) for path in seq.frame_paths]
-    tracker = IemdTracker()
-    tracker.init(frames[0], seq.gt_boxes[0])
-    boxes, ok = [np.asarray(seq.gt_boxes[0], float)], [True]
-    for frame in frames[1:]:
-        result = tracker.update(frame)
-        boxes.append(np.asarray(result.box, float))
-        ok.append(not result.lost)
-    scores = long_term_scores(np.vstack(boxes), np.asarray(ok), seq.gt_boxes)
+    boxes, ok, _ = _track_cut(seq)
+    scores = long_term_scores(boxes, ok, seq.gt_boxes)
     absent = np.isnan(seq.gt_boxes[:, 0])
-    assert absent.sum() >= 25 and np.mean(np.asarray(ok)[absent]) <= 0.1
+    assert absent.sum() >= 25 and np.mean(ok[absent]) <= 0.1
     assert scores.reacquired == scores.returns == 1, scores
     assert scores.f_score >= 0.6, scores
+
+
+def test_a_target_back_at_another_size_is_re_detected_at_that_size(
+    tmp_path, otb_root, monkeypatch
+):
+    """
+    Freeman1 cut to look away after 40 frames: he walks towards the camera while it looks away.
+
+    He comes back about 1.4 times as tall as the window the tracker lost; at the lost size the
+    filter's peak stays below ``found_response`` times its mean.  The re-detection's other sizes
+    find him within REACQUIRE_WITHIN frames of his return, in a window at least 1.2 times the lost
+    one's height; searched at the lost size only, he is not found in that time
+    (docs/decisions.md#redetect-sizes).
+    """
+    seq = load_sequence(
+        write_look_away(
+            load_sequence(otb_root / 'Freeman1'), tmp_path / 'la', LookAway(follow_frames=40)
+        )
+    )
+    boxes, found, results = _track_cut(seq)
+    scores = long_term_scores(boxes, found, seq.gt_boxes)
+    assert scores.returns == scores.reacquired == 1, scores
+    redetected = [k for k, r in enumerate(results) if r.cause is Cause.REDETECTED]
+    lost_before = next(r for r in results if r.lost).box
+    assert redetected and results[redetected[0]].box[3] >= 1.2 * lost_before[3], results
+    assert 'another size' in results[redetected[0]].reason
+
+    monkeypatch.setattr(tracker_module, 'REDETECT_SIZES', (1.0,))
+    boxes, found, _ = _track_cut(seq)
+    assert long_term_scores(boxes, found, seq.gt_boxes).reacquired == 0
 
 
 def test_several_follow_lengths_give_one_cut_each_that_the_split_selects_by_source(

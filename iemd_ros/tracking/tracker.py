@@ -77,6 +77,9 @@ CONFIDENCE_RATE = 0.1
 WORKERS = 2  # threads the independent models of a frame run on, beside the caller's
 # lost frames searched only around the prediction before the whole frame is searched too
 FRAME_SEARCH_AFTER = 5
+# re-detection's other sizes, relative to the lost window's, one per lost frame in turn: TLD's
+# scanning grid steps the size by 1.2 (Kalal et al., TPAMI 2012, section 5.3)
+REDETECT_SIZES = (1.2**-2, 1.2**-1, 1.2, 1.2**2)
 
 
 class Cause(enum.Enum):
@@ -450,9 +453,12 @@ class IemdTracker:
         The filter searches where the target was lost (that place moved by the priors since), then,
         lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near where it
         happened), one strip of the whole frame (the frame is scanned over lost frames) refined by
-        a search at its peak.  The result when the best peak reaches ``found_response`` times the
-        running mean and its window's EMD is below the lost limit, else None.  Nothing learns from
-        the frame.
+        a search at its peak.  Where no peak reaches ``found_response`` times the running mean, the
+        filter searches those places again at one other size of ``REDETECT_SIZES`` (a target may
+        come back nearer or farther); a window found so keeps the lost size unless its EMD is lower
+        at the other (the paper's scale rule, section 6.1).  The result when the best peak reaches
+        ``found_response`` times the running mean and its window's EMD is below the lost limit,
+        else None.  Nothing learns from the frame.
         """
         tf, cfg = self._translation_filter, self.config
         # no frame learned yet: no response to compare a candidate with
@@ -469,9 +475,26 @@ class IemdTracker:
             self._search_part = (self._search_part + 1) % parts
             candidates.append(self._filter_peak(frame, coarse, size, angle))
         found, peak = max(candidates, key=lambda c: c[1], default=(None, -np.inf))
+        other = None
+        if peak < wanted and candidates:
+            other = size * REDETECT_SIZES[self._lost_frames % len(REDETECT_SIZES)]
+            found, peak = max(
+                (
+                    self._filter_peak(frame, place, other, angle)
+                    for place, _ in candidates
+                    if _visible_fraction(place, other, angle, frame.shape) >= cfg.min_visible
+                ),
+                key=lambda c: c[1],
+                default=(None, -np.inf),
+            )
         if peak < wanted:
             return None
-        emd = CandidateModel(self._context(pyramid, angle), found, size).emd()[0]
+        context = self._context(pyramid, angle)
+        emd = CandidateModel(context, found, size).emd()[0]
+        if other is not None:
+            emd_other = CandidateModel(context, found, other).emd()[0]
+            if emd_other < emd:
+                emd, size = emd_other, other
         if self._lost_reason(emd, found, size, angle, frame.shape)[0] is not None:
             return None
         self._center, self._size, self._angle, self._lost, self._lost_frames = (
@@ -488,12 +511,13 @@ class IemdTracker:
             iterations=0,
             lost=False,
             angle=angle,
-            starts=starts + len(candidates),
-            codings=codings + 1,
+            starts=starts + len(candidates) * (1 if other is None else 2),
+            codings=codings + (1 if other is None else 2),
             predicted_box=predicted,
             cause=Cause.REDETECTED,
             reason=(
                 f're-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean'
+                + (f', at {size[0]:.0f}x{size[1]:.0f} px (another size)' if size is other else '')
             ),
         )
 
