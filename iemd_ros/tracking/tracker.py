@@ -475,18 +475,16 @@ class IemdTracker:
             self._search_part = (self._search_part + 1) % parts
             candidates.append(self._filter_peak(frame, coarse, size, angle))
         found, peak = max(candidates, key=lambda c: c[1], default=(None, -np.inf))
-        other = None
+        other, searched = None, len(candidates)
         if peak < wanted and candidates:
             other = size * REDETECT_SIZES[self._lost_frames % len(REDETECT_SIZES)]
-            found, peak = max(
-                (
-                    self._filter_peak(frame, place, other, angle)
-                    for place, _ in candidates
-                    if _visible_fraction(place, other, angle, frame.shape) >= cfg.min_visible
-                ),
-                key=lambda c: c[1],
-                default=(None, -np.inf),
-            )
+            peaks = [
+                self._filter_peak(frame, place, other, angle)
+                for place, _ in candidates
+                if _visible_fraction(place, other, angle, frame.shape) >= cfg.min_visible
+            ]
+            searched += len(peaks)
+            found, peak = max(peaks, key=lambda c: c[1], default=(None, -np.inf))
         if peak < wanted:
             return None
         context = self._context(pyramid, angle)
@@ -511,7 +509,7 @@ class IemdTracker:
             iterations=0,
             lost=False,
             angle=angle,
-            starts=starts + len(candidates) * (1 if other is None else 2),
+            starts=starts + searched,
             codings=codings + (1 if other is None else 2),
             predicted_box=predicted,
             cause=Cause.REDETECTED,
