@@ -285,7 +285,9 @@ class TranslationFilter:
             ((hi - lo) * features.CELL, cells[0] * features.CELL),
         )
         z = features.extract(strip, self.colour)
-        shape = (cells[0] + n, hi - lo + n)
+        # zero-padded to at least the strip plus the filter (linear correlation), at sizes the FFT
+        # factors well
+        shape = tuple(sfft.next_fast_len(k, real=True) for k in (cells[0] + n, hi - lo + n))
         if (
             self._frame_filter is None
             or self._frame_filter[0] is not self.f
