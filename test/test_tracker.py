@@ -41,7 +41,14 @@ from iemd_ros.tracking import tracker as tracker_module
 from iemd_ros.tracking.analysis import descend, descent_tracker, search_context
 from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.tracking.template import TemplateDictionary
-from iemd_ros.tracking.tracker import _scale_bounds, _visible_fraction, Cause, MIN_SIDE_PX
+from iemd_ros.tracking.tracker import (
+    _redetect_factor,
+    _scale_bounds,
+    _visible_fraction,
+    Cause,
+    MIN_SIDE_PX,
+    REDETECT_SIZES,
+)
 import numpy as np
 import pytest
 
@@ -603,3 +610,22 @@ def test_update_returns_before_the_models_learn_and_the_next_call_waits_for_them
     with pytest.raises(RuntimeError, match='learning failed'):
         tracker.wait_learned()
     tracker.wait_learned()  # raised once
+
+
+def test_re_detection_tries_each_other_size_in_turn_within_the_scale_bounds():
+    """
+    REDETECT_SIZES in turn over a loss's frames.
+
+    A size that would leave the scale search's bounds (shorter side MIN_SIDE_PX, the image's area)
+    stops at the bound, and one already there is 1.
+    """
+    shape = (100, 100)
+    assert [_redetect_factor(k, (40, 30), shape) for k in range(5)] == [
+        *REDETECT_SIZES,
+        REDETECT_SIZES[0],
+    ]
+    small = [_redetect_factor(k, (5, 6), shape) for k in range(4)]
+    assert min(small) == pytest.approx(MIN_SIDE_PX / 5) and max(small) == REDETECT_SIZES[-1]
+    large = [_redetect_factor(k, (90, 90), shape) for k in range(4)]
+    assert max(large) == pytest.approx(100 / 90) and min(large) == REDETECT_SIZES[0]
+    assert {_redetect_factor(k, (MIN_SIDE_PX, 50), shape) for k in range(2)} == {1.0}

@@ -476,8 +476,9 @@ class IemdTracker:
             candidates.append(self._filter_peak(frame, coarse, size, angle))
         found, peak = max(candidates, key=lambda c: c[1], default=(None, -np.inf))
         other, searched = None, len(candidates)
-        if peak < wanted and candidates:
-            other = size * REDETECT_SIZES[self._lost_frames % len(REDETECT_SIZES)]
+        factor = _redetect_factor(self._lost_frames, size, frame.shape)
+        if peak < wanted and candidates and factor != 1.0:
+            other = size * factor
             peaks = [
                 self._filter_peak(frame, place, other, angle)
                 for place, _ in candidates
@@ -883,6 +884,17 @@ def _scale_bounds(size, shape) -> tuple[float, float]:
     lower = MIN_SIDE_PX / float(min(size))
     upper = float(np.sqrt(shape[0] * shape[1] / (size[0] * size[1])))
     return min(lower, 1.0), max(upper, 1.0)
+
+
+def _redetect_factor(lost_frames: int, size, shape) -> float:
+    """
+    Return the other size re-detection searches on a loss's ``lost_frames``-th frame.
+
+    A factor on the lost size: ``REDETECT_SIZES`` in turn, held within the scale search's bounds
+    (:func:`_scale_bounds`); 1.0 where the lost size is already at the bound.
+    """
+    factor = REDETECT_SIZES[lost_frames % len(REDETECT_SIZES)]
+    return float(np.clip(factor, *_scale_bounds(size, shape)))
 
 
 def _not_optimal(solution) -> int:
