@@ -476,8 +476,8 @@ class IemdTracker:
             candidates.append(self._filter_peak(frame, coarse, size, angle))
         found, peak = max(candidates, key=lambda c: c[1], default=(None, -np.inf))
         other, searched = None, len(candidates)
-        factor = _redetect_factor(self._lost_frames, size, frame.shape)
-        if peak < wanted and candidates and factor != 1.0:
+        factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
+        if candidates and factor != 1.0:
             other = size * factor
             peaks = [
                 self._filter_peak(frame, place, other, angle)
@@ -488,12 +488,12 @@ class IemdTracker:
             found, peak = max(peaks, key=lambda c: c[1], default=(None, -np.inf))
         if peak < wanted:
             return None
-        context = self._context(pyramid, angle)
-        emd = CandidateModel(context, found, size).emd()[0]
-        if other is not None:
-            emd_other = CandidateModel(context, found, other).emd()[0]
+        model = CandidateModel(self._context(pyramid, angle), found, size)
+        emd, resized = model.emd()[0], False
+        if other is not None:  # the scale variant at the same centre
+            emd_other = model.at(found, other).emd()[0]
             if emd_other < emd:
-                emd, size = emd_other, other
+                emd, size, resized = emd_other, other, True
         if self._lost_reason(emd, found, size, angle, frame.shape)[0] is not None:
             return None
         self._center, self._size, self._angle, self._lost, self._lost_frames = (
@@ -516,7 +516,7 @@ class IemdTracker:
             cause=Cause.REDETECTED,
             reason=(
                 f're-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean'
-                + (f', at {size[0]:.0f}x{size[1]:.0f} px (another size)' if size is other else '')
+                + (f', at {size[0]:.0f}x{size[1]:.0f} px (another size)' if resized else '')
             ),
         )
 
