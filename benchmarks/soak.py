@@ -30,7 +30,7 @@
 """
 Bounded soak of the tracker node as its own process.
 
-RSS sampled over a run of fixed length, and its slope.
+RSS and CPU time sampled over a run of fixed length, and the RSS's slope.
 
     .venv/bin/python benchmarks/soak.py [--minutes 30] [--rate 30] [--width 640 --height 480]
                                         [--sample-s 10]
@@ -40,10 +40,12 @@ otherwise) on an isolated DDS domain on this host; this process publishes a synt
 sequence over and over (bgr8 frames with increasing stamps, IMU at 200 Hz, CameraInfo with every
 frame, sensor-data QoS, over ``config/fastdds_shm.xml`` unless ``--default-transport``), restarting
 the target with ``~/init`` at each pass.  Every ``--sample-s`` seconds it reads the tracker's RSS
-(``/proc/<pid>/status``), the frames answered, and the tracker's own counts and worst status
-(tracking, image input) from /diagnostics.  It prints the RSS at the start, after 1 minute and at
-the end, and the slope of a least-squares line through the samples after the first minute and
-through those of the second half (MB per hour).  It stops by itself after ``--minutes`` and stops
+(``/proc/<pid>/status``) and CPU time (user and system, ``/proc/<pid>/stat``), the frames
+answered, and the tracker's own counts and worst status (tracking, image input) from
+/diagnostics.  It prints the RSS at the start, after 1 minute and at the end, the slope of a
+least-squares line through the samples after the first minute and through those of the second
+half (MB per hour), and the tracker's CPU use after the first minute (CPU time over wall time, %
+of one core).  It stops by itself after ``--minutes`` and stops
 the tracker with SIGINT.  The tracker's log goes to ``--log`` or is discarded: never to a pipe
 nobody reads, where it would block the tracker once the pipe is full.
 """
@@ -69,6 +71,14 @@ def rss_mb(pid: int) -> float:
     raise RuntimeError(f'no VmRSS for process {pid}')
 
 
+def cpu_s(pid: int) -> float:
+    """User and system CPU time of the process ``pid`` (all its threads) so far, s."""
+    with open(f'/proc/{pid}/stat') as f:
+        # the fields after the command name (which may hold spaces), from field 3 (state) on
+        fields = f.read().rsplit(')', 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf('SC_CLK_TCK')
+
+
 def slope_mb_per_hour(t_s, rss) -> float:
     """
     Slope of the least-squares line through (t_s, rss).
@@ -81,6 +91,7 @@ def slope_mb_per_hour(t_s, rss) -> float:
 
 
 def main(argv=None) -> int:
+    """Run the soak; return the exit status."""
     ap = argparse.ArgumentParser(description=__doc__.strip().split('\n')[0])
     ap.add_argument('--minutes', type=float, default=30.0, help='length of the soak, min')
     ap.add_argument('--rate', type=float, default=30.0, help='input rate, Hz')
@@ -195,7 +206,7 @@ def main(argv=None) -> int:
             f'{proc.pid}; RSS every {args.sample_s:g} s',
             flush=True,
         )
-        samples: list[tuple[float, float, int, int]] = []
+        samples: list[tuple[float, float, int, int, float]] = []
         t0 = time.monotonic()
         end = t0 + args.minutes * 60.0
         n, gi, next_sample = 0, 0, t0
@@ -230,7 +241,13 @@ def main(argv=None) -> int:
             if now >= next_sample:
                 with lock:
                     samples.append(
-                        (now - t0, rss_mb(proc.pid), counts['answered'], counts['detected'])
+                        (
+                            now - t0,
+                            rss_mb(proc.pid),
+                            counts['answered'],
+                            counts['detected'],
+                            cpu_s(proc.pid),
+                        )
                     )
                     worst = max(diag.get(p, (0, '')) for p in ('tracking', 'image input'))
                     seen = {
@@ -239,8 +256,14 @@ def main(argv=None) -> int:
                     }
                 next_sample += args.sample_s
                 s = samples[-1]
+                cpu = (
+                    (s[4] - samples[-2][4]) / (s[0] - samples[-2][0])
+                    if len(samples) > 1
+                    else float('nan')
+                )
                 print(
-                    f'  {s[0] / 60:6.2f} min  RSS {s[1]:7.1f} MB  sent {n}  answered {s[2]}  with '
+                    f'  {s[0] / 60:6.2f} min  RSS {s[1]:7.1f} MB  CPU {cpu:6.1%}  sent {n}  '
+                    f'answered {s[2]}  with '
                     'a detection '
                     f'{s[3]}  tracker: received {seen["received"]} processed {seen["processed"]} '
                     'dropped '
@@ -252,7 +275,13 @@ def main(argv=None) -> int:
             return 1
         with lock:
             samples.append(
-                (time.monotonic() - t0, rss_mb(proc.pid), counts['answered'], counts['detected'])
+                (
+                    time.monotonic() - t0,
+                    rss_mb(proc.pid),
+                    counts['answered'],
+                    counts['detected'],
+                    cpu_s(proc.pid),
+                )
             )
     finally:
         ex.shutdown(timeout_sec=2.0)
@@ -266,6 +295,7 @@ def main(argv=None) -> int:
                 proc.kill()
     t = np.array([s[0] for s in samples])
     rss = np.array([s[1] for s in samples])
+    cpu = np.array([s[4] for s in samples])
     one = int(np.argmin(np.abs(t - 60.0)))
     later = t >= 60.0
     last = samples[-1]
@@ -277,6 +307,12 @@ def main(argv=None) -> int:
         f'{slope_mb_per_hour(t[later], rss[later]):+.2f} MB/h, over the second half '
         f'{slope_mb_per_hour(t[half], rss[half]):+.2f} MB/h'
     )
+    if t[-1] > t[one]:
+        used, span = cpu[-1] - cpu[one], t[-1] - t[one]
+        print(
+            f'tracker CPU after the first minute: {used / span:.1%} of one core '
+            f'({used:.1f} s in {span:.1f} s)'
+        )
     print(
         f'frames sent {n}, answered {last[2]} ({last[2] / max(n, 1):.1%}), with a detection '
         f'{last[3]} '
