@@ -45,9 +45,9 @@ answered, and the tracker's own counts and worst status (tracking, image input) 
 /diagnostics.  It prints the RSS at the start, after 1 minute and at the end, the slope of a
 least-squares line through the samples after the first minute and through those of the second
 half (MB per hour), and the tracker's CPU use after the first minute (CPU time over wall time, %
-of one core).  It stops by itself after ``--minutes`` and stops
-the tracker with SIGINT.  The tracker's log goes to ``--log`` or is discarded: never to a pipe
-nobody reads, where it would block the tracker once the pipe is full.
+of one core).  It stops by itself after ``--minutes`` and stops the tracker with SIGINT.  The
+tracker's log goes to ``--log`` or is discarded: never to a pipe nobody reads, where it would block
+the tracker once the pipe is full.
 """
 from __future__ import annotations
 
@@ -206,6 +206,11 @@ def main(argv=None) -> int:
             f'{proc.pid}; RSS every {args.sample_s:g} s',
             flush=True,
         )
+
+        # (s since the start, RSS MB, answered, with a detection, CPU s), taken under the lock
+        def sample(t_s: float) -> tuple[float, float, int, int, float]:
+            return t_s, rss_mb(proc.pid), counts['answered'], counts['detected'], cpu_s(proc.pid)
+
         samples: list[tuple[float, float, int, int, float]] = []
         t0 = time.monotonic()
         end = t0 + args.minutes * 60.0
@@ -240,15 +245,7 @@ def main(argv=None) -> int:
             now = time.monotonic()
             if now >= next_sample:
                 with lock:
-                    samples.append(
-                        (
-                            now - t0,
-                            rss_mb(proc.pid),
-                            counts['answered'],
-                            counts['detected'],
-                            cpu_s(proc.pid),
-                        )
-                    )
+                    samples.append(sample(now - t0))
                     worst = max(diag.get(p, (0, '')) for p in ('tracking', 'image input'))
                     seen = {
                         k: diag.get(f'frames_{k}', '?')
@@ -274,15 +271,7 @@ def main(argv=None) -> int:
             print(f'soak: the tracker exited early with status {proc.returncode}', file=sys.stderr)
             return 1
         with lock:
-            samples.append(
-                (
-                    time.monotonic() - t0,
-                    rss_mb(proc.pid),
-                    counts['answered'],
-                    counts['detected'],
-                    cpu_s(proc.pid),
-                )
-            )
+            samples.append(sample(time.monotonic() - t0))
     finally:
         ex.shutdown(timeout_sec=2.0)
         node.destroy_node()
