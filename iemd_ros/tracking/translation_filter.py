@@ -67,6 +67,7 @@ from iemd_ros.tracking.correlation_filter import (
     energy,
     gaussian_label,
     hann_inner,
+    psr,
     sample_region,
     SubCellPeak,
 )
@@ -309,13 +310,15 @@ class TranslationFilter:
     @property
     def confidence(self) -> dict:
         """
-        Return the last estimate's peak value and APCE (LMCF's average peak-to-correlation energy).
+        Return the last estimate's peak value, APCE and PSR.
 
-        Computed when asked; {} before any estimate.
+        LMCF's average peak-to-correlation energy and MOSSE's peak-to-sidelobe ratio, computed
+        when asked; {} before any estimate.
         """
         if self._response is None:
             return {}
-        return {'peak': self.response_peak, 'apce': apce(self._response[0])}
+        resp = self._response[0]
+        return {'peak': self.response_peak, 'apce': apce(resp), 'psr': psr(resp)}
 
     # ------------------------------------------------------------------ learning
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
