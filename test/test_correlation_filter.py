@@ -34,13 +34,7 @@ The features and shared pieces against hand-computed cases, and STRCF's ADMM aga
 solve of its objective.
 """
 from iemd_ros.tracking import features as F
-from iemd_ros.tracking.correlation_filter import (
-    apce,
-    gaussian_label,
-    psr,
-    sample_region,
-    SubCellPeak,
-)
+from iemd_ros.tracking.correlation_filter import apce, gaussian_label, sample_region, SubCellPeak
 from iemd_ros.tracking.translation_filter import TranslationFilter
 import numpy as np
 import pytest
@@ -177,21 +171,6 @@ def test_the_sub_cell_peak_of_a_shifted_gaussian():
     resp = np.exp(-0.5 * d2 / 4.0)
     dy, dx, _ = SubCellPeak(rows, cols)(resp, sfft.rfft2(resp))
     assert abs(dy - dy0) < 0.02 and abs(dx - dx0) < 0.02 and apce(resp) > 10
-
-
-def test_the_peak_to_sidelobe_ratio_tells_a_distinct_peak_from_noise():
-    """
-    The peak-to-sidelobe ratio (MOSSE): high for a sharp peak over noise, low for noise alone.
-
-    It does not change with the response's scale and offset, and is 0 for a flat sidelobe.
-    """
-    rng = np.random.default_rng(0)
-    noise = 0.05 * rng.standard_normal((40, 40))
-    peak = np.roll(gaussian_label(40, 40, 1.5).astype(np.float64), (7, -11), axis=(0, 1))
-    sharp = peak + noise
-    assert psr(sharp) > 7 > psr(noise)
-    assert psr(3.0 * sharp + 2.0) == pytest.approx(psr(sharp))
-    assert psr(np.zeros((16, 16))) == 0.0
 
 
 # -------------------------------------------------------------------------------- STRCF's solver

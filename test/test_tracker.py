@@ -46,7 +46,6 @@ from iemd_ros.tracking.tracker import (
     _scale_bounds,
     _visible_fraction,
     Cause,
-    CONFIRM_FRAMES,
     MIN_SIDE_PX,
     REDETECT_SIZES,
 )
@@ -257,37 +256,6 @@ def test_a_target_lost_before_any_frame_learned_stays_lost_frame_after_frame():
     H = np.array([[1, 0, -80.0], [0, 1, 0], [0, 0, 1]])
     results = [tracker.update(frame, prior=H) for _ in range(3)]
     assert all(r.lost and r.cause is Cause.OUT_OF_VIEW for r in results)
-
-
-def test_a_weaker_re_detection_needs_one_place_on_confirm_frames_lost_frames_in_a_row(
-    monkeypatch,
-):
-    """
-    A candidate below found_response counts once its peak reaches confirm_response x the mean.
-
-    CONFIRM_FRAMES of them within half the window of each other confirm; a far one starts a new
-    run, a weak one ends it.  While lost, the prior moves the run's place with the camera.
-    """
-    frame = texture(seed=3)
-    tracker = IemdTracker()
-    tracker.init(frame, (2.0, 100.0, 40.0, 40.0))
-    tracker._confidence = 1.0
-    size, level = np.array([40.0, 40.0]), tracker.config.confirm_response
-    places = [(50, 50), (60, 45), (200, 50), (205, 55), (210, 50)]
-    runs = [tracker._confirmed(np.array(p, float), level, size) for p in places]
-    assert CONFIRM_FRAMES == 3 and runs == [False, False, False, False, True]
-    assert not tracker._confirmed(np.array([210.0, 50.0]), 0.9 * level, size)
-    assert tracker._candidates_run == (None, 0)
-
-    off = np.array([[1, 0, -80.0], [0, 1, 0], [0, 0, 1]])
-    assert tracker.update(frame, prior=off).lost
-    tracker._candidates_run = (np.array([150.0, 100.0]), 2)
-    seen = []
-    monkeypatch.setattr(tracker, '_redetect', lambda *a: seen.append(tracker._candidates_run))
-    turn = np.array([[1, 0, 30.0], [0, 1, -10.0], [0, 0, 1]])
-    assert tracker.update(frame, prior=turn).lost
-    np.testing.assert_allclose(seen[0][0], [180.0, 90.0])
-    assert seen[0][1] == 2
 
 
 def test_solver_warnings_count_each_non_optimal_solve_once(monkeypatch):

@@ -250,13 +250,6 @@ class TrackerConfig:
         range=(0.01, 10.0),
         decision='re-detection',
     )
-    confirm_response: float = param(
-        0.7,
-        "while lost, a window is also taken where the filter's peak reaches this times its "
-        'running mean at one place on 3 lost frames in a row',
-        range=(0.01, 10.0),
-        decision='redetection-confirmed',
-    )
     lost_factor: float = param(
         1.0,
         'lost when EMD > this x the background EMD measured at init',

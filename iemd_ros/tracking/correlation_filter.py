@@ -43,7 +43,7 @@ from iemd_ros.tracking.appearance import window_axes
 import numba
 import numpy as np
 
-__all__ = ['sample_region', 'hann_inner', 'gaussian_label', 'apce', 'psr', 'SubCellPeak']
+__all__ = ['sample_region', 'hann_inner', 'gaussian_label', 'apce', 'SubCellPeak']
 
 
 # -------------------------------------------------------------------------------- sampling
@@ -167,36 +167,6 @@ def apce(resp: np.ndarray) -> float:
     mx, mn = float(resp.max()), float(resp.min())
     den = float(np.mean((resp - mn) ** 2))
     return (mx - mn) ** 2 / den if den > 0 else 0.0
-
-
-def psr(resp: np.ndarray) -> float:
-    """
-    Peak-to-sidelobe ratio ``(F_max - mean(S)) / std(S)`` of a response.
-
-    From MOSSE (Bolme et al., CVPR 2010, sec. 3.4): the sidelobe ``S`` is the response less the
-    11 x 11 of a 64 x 64 response around the peak, scaled to the response's shape (circularly).
-
-    Parameters
-    ----------
-    resp : ndarray
-        (rows, cols) correlation response.
-
-    Returns
-    -------
-    float
-        The ratio; MOSSE reads one below 7 as a failure (0 for a response with a flat sidelobe).
-
-    """
-    r = np.asarray(resp, dtype=np.float64)
-    rows, cols = r.shape
-    iy, ix = np.unravel_index(int(np.argmax(r)), r.shape)
-    hy, hx = max(1, round(rows * 11 / 128)), max(1, round(cols * 11 / 128))
-    sidelobe = np.ones(r.shape, bool)
-    ys, xs = np.arange(iy - hy, iy + hy + 1) % rows, np.arange(ix - hx, ix + hx + 1) % cols
-    sidelobe[np.ix_(ys, xs)] = False
-    side = r[sidelobe]
-    std = float(side.std())
-    return (float(r.max()) - float(side.mean())) / std if std > 0 else 0.0
 
 
 class SubCellPeak:

@@ -80,12 +80,6 @@ FRAME_SEARCH_AFTER = 5
 # re-detection's other sizes, relative to the lost window's, one per lost frame in turn: TLD's
 # scanning grid steps the size by 1.2 (Kalal et al., TPAMI 2012, section 5.3)
 REDETECT_SIZES = (1.2**-2, 1.2**-1, 1.2, 1.2**2)
-# a peak below found_response is taken once seen at one place on this many lost frames in a row:
-# SORT's confirmation of a new track (min_hits, Bewley et al., ICIP 2016)
-CONFIRM_FRAMES = 3
-# a re-detection is taken only at a distinct peak: MOSSE reads a peak-to-sidelobe ratio below 7
-# as a failure (Bolme et al., CVPR 2010, sec. 3.4)
-MIN_PSR = 7.0
 
 
 class Cause(enum.Enum):
@@ -242,8 +236,6 @@ class IemdTracker:
         # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
         self._search_part = 0
         self._lost_frames = 0  # lost frames in a row
-        # (place, lost frames in a row) of the best re-detection candidates below found_response
-        self._candidates_run = (None, 0)
         # lost: where the target was lost, moved by the priors since (re-detection looks there)
         self._anchor = None
         self._prediction = None  # this frame's predicted centre
@@ -283,14 +275,12 @@ class IemdTracker:
             self._angle,
             self._anchor,
         )
-        place, run = self._candidates_run
         # may raise ValueError: before any state changes, so a retry sees none
         if prior is not None:
             prior = _check_prior(prior)
             center, size, turn = _apply_prior(prior, center, size)
             angle = _wrap_angle(angle + turn)
             anchor = None if anchor is None else _apply_prior(prior, anchor, size)[0]
-            place = None if place is None else _apply_prior(prior, place, size)[0]
         cfg = self.config
         # what needs no model (grey levels, pyramid, flow, the filter's sample) runs while the
         # models still learn from the last frame
@@ -308,7 +298,7 @@ class IemdTracker:
         self.wait_learned()
         self._previous = grey if cfg.flow_start else None
         self._frame_index += 1
-        self._anchor, self._prediction, self._candidates_run = anchor, center, (place, run)
+        self._anchor, self._prediction = anchor, center
         predicted = _box(center, size, angle)
         # the prior moved the window out of view: keep its place, search only the frame
         if visible < cfg.min_visible:
@@ -422,7 +412,6 @@ class IemdTracker:
         """
         if not self._lost:
             self._anchor = np.asarray(self._prediction, dtype=np.float64)
-            self._candidates_run = (None, 0)
         self._center, self._size, self._angle, self._lost = center, size, angle, True
         self._lost_frames += 1
         return TrackResult(
@@ -468,17 +457,15 @@ class IemdTracker:
         filter searches those places again at one other size of ``REDETECT_SIZES`` (a target may
         come back nearer or farther); a window found so keeps the lost size unless its EMD is lower
         at the other (the paper's scale rule, section 6.1).  The result when the best peak reaches
-        ``found_response`` times the running mean, or ``confirm_response`` times it at one place on
-        ``CONFIRM_FRAMES`` lost frames in a row (:meth:`_confirmed`), is a distinct peak
-        (``MIN_PSR``) and its window's EMD is below the lost limit; else None.  Nothing learns from
-        the frame.
+        ``found_response`` times the running mean and its window's EMD is below the lost limit,
+        else None.  Nothing learns from the frame.
         """
         tf, cfg = self._translation_filter, self.config
         # no frame learned yet: no response to compare a candidate with
         if tf is None or self._confidence is None:
             return None
         wanted = cfg.found_response * self._confidence
-        candidates = []  # (centre, filter peak there, its peak-to-sidelobe ratio)
+        candidates = []  # (centre, filter peak there)
         if _visible_fraction(self._anchor, size, angle, frame.shape) >= cfg.min_visible:
             candidates.append(self._filter_peak(frame, self._anchor, size, angle))
         if self._lost_frames >= FRAME_SEARCH_AFTER and not (
@@ -487,20 +474,19 @@ class IemdTracker:
             coarse, _, parts = tf.search_frame(frame, size, self._search_part)
             self._search_part = (self._search_part + 1) % parts
             candidates.append(self._filter_peak(frame, coarse, size, angle))
-        found, peak, psr = max(candidates, key=lambda c: c[1], default=(None, -np.inf, 0.0))
+        found, peak = max(candidates, key=lambda c: c[1], default=(None, -np.inf))
         other, searched = None, len(candidates)
         factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
         if candidates and factor != 1.0:
             other = size * factor
             peaks = [
                 self._filter_peak(frame, place, other, angle)
-                for place, _, _ in candidates
+                for place, _ in candidates
                 if _visible_fraction(place, other, angle, frame.shape) >= cfg.min_visible
             ]
             searched += len(peaks)
-            found, peak, psr = max(peaks, key=lambda c: c[1], default=(None, -np.inf, 0.0))
-        confirmed = self._confirmed(found, peak, size)
-        if (peak < wanted and not confirmed) or psr < MIN_PSR:
+            found, peak = max(peaks, key=lambda c: c[1], default=(None, -np.inf))
+        if peak < wanted:
             return None
         model = CandidateModel(self._context(pyramid, angle), found, size)
         emd, resized = model.emd()[0], False
@@ -530,38 +516,14 @@ class IemdTracker:
             cause=Cause.REDETECTED,
             reason=(
                 f're-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean'
-                if peak >= wanted
-                else f're-detected: filter peak {peak:.3f} >= {cfg.confirm_response} x its '
-                f'running mean at one place on {CONFIRM_FRAMES} lost frames in a row'
-            )
-            + (f', at {size[0]:.0f}x{size[1]:.0f} px (another size)' if resized else ''),
+                + (f', at {size[0]:.0f}x{size[1]:.0f} px (another size)' if resized else '')
+            ),
         )
 
-    def _confirmed(self, found, peak: float, size) -> bool:
-        """
-        Whether this lost frame's best candidate ``found`` confirms a run of ``CONFIRM_FRAMES``.
-
-        A run continues where the candidate's peak reaches ``confirm_response`` times the running
-        mean within half the lost window's size ``size`` of the last frame's candidate (that place
-        moved by the prior since); it ends on a frame without one.
-        """
-        if found is None or peak < self.config.confirm_response * self._confidence:
-            self._candidates_run = (None, 0)
-            return False
-        place, run = self._candidates_run
-        near = place is not None and bool(np.all(np.abs(found - place) <= 0.5 * size))
-        self._candidates_run = (found, run + 1 if near else 1)
-        return self._candidates_run[1] >= CONFIRM_FRAMES
-
-    def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float, float]:
-        """
-        (centre, value, peak-to-sidelobe ratio) of the translation filter's peak.
-
-        In its search region around ``at``.
-        """
+    def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float]:
+        """(centre, value) of the translation filter's peak in its search region around ``at``."""
         tf = self._translation_filter
-        move = tf.estimate(tf.sample(frame, at, size, angle))
-        return at + move, tf.response_peak, tf.confidence['psr']
+        return at + tf.estimate(tf.sample(frame, at, size, angle)), tf.response_peak
 
     def _search_all(self, frame, flow, region, pyramid, center, size, angle):
         """

@@ -67,7 +67,6 @@ from iemd_ros.tracking.correlation_filter import (
     energy,
     gaussian_label,
     hann_inner,
-    psr,
     sample_region,
     SubCellPeak,
 )
@@ -310,15 +309,13 @@ class TranslationFilter:
     @property
     def confidence(self) -> dict:
         """
-        Return the last estimate's peak value, APCE and PSR.
+        Return the last estimate's peak value and APCE (LMCF's average peak-to-correlation energy).
 
-        LMCF's average peak-to-correlation energy and MOSSE's peak-to-sidelobe ratio, computed
-        when asked; {} before any estimate.
+        Computed when asked; {} before any estimate.
         """
         if self._response is None:
             return {}
-        resp = self._response[0]
-        return {'peak': self.response_peak, 'apce': apce(resp), 'psr': psr(resp)}
+        return {'peak': self.response_peak, 'apce': apce(self._response[0])}
 
     # ------------------------------------------------------------------ learning
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
