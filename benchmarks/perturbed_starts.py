@@ -50,17 +50,21 @@ A difference between two trackers is printed run by run (``paired_difference``: 
 in points, its 95 % interval with whole sequences resampled, the runs better, worse and equal):
 every configuration after the first against the first, and, with ``--against FILE``, every tracker
 of this run against the first of a run saved by ``--save FILE`` (the same starts and shift; another
-source tree, say).
+source tree, say).  A saved run records the digest of the ``iemd_ros.tracking`` sources it ran and
+when; the comparison prints both digests, so that a reference saved from an older tracker is seen
+as such.
 """
 from __future__ import annotations
 
 import argparse
 import ast
+import datetime
+import hashlib
 import json
 from multiprocessing import Pool
 from pathlib import Path
 
-from iemd_ros import TrackerConfig
+from iemd_ros import TrackerConfig, tracking
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation.metrics import paired_difference, score_sequence
@@ -160,6 +164,7 @@ def main() -> None:
         if args.against is None
         else _load_reference(args.against, args.starts, args.shift, names)
     )
+    digest = _tracker_digest()
     # Checked here, before any run: a bad key or peer fails at once with its own message.
     runs = [
         (
@@ -211,14 +216,20 @@ def main() -> None:
         if i > 0 and runs[i][1] == 'iemd':
             _print_difference(overlap, overlaps[first], first)
         if reference is not None:
-            ref_label, ref_overlap = reference
-            _print_difference(overlap, ref_overlap, f'{ref_label} ({args.against})')
+            ref_label, ref_overlap, ref_source = reference
+            _print_difference(
+                overlap,
+                ref_overlap,
+                f'{ref_label} ({args.against}: {ref_source}; this run: tracker sources {digest})',
+            )
     if args.save is not None:
         args.save.write_text(
             json.dumps(
                 {
                     'starts': args.starts,
                     'shift': args.shift,
+                    'tracker_sources': digest,
+                    'saved': datetime.datetime.now().isoformat(timespec='seconds'),
                     'runs': {
                         label: {n: [float(v) for v in row] for n, row in zip(names, o)}
                         for label, o in overlaps.items()
@@ -237,9 +248,21 @@ def _print_difference(ours: np.ndarray, reference: np.ndarray, label: str) -> No
     )
 
 
-def _load_reference(path: Path, starts: str, shift: float, names) -> tuple[str, np.ndarray]:
+def _tracker_digest() -> str:
+    """First 12 hex digits of the SHA-256 of the ``iemd_ros.tracking`` sources this run imports."""
+    root = Path(tracking.__file__).parent
+    h = hashlib.sha256()
+    for path in sorted(root.rglob('*.py')):
+        h.update(path.relative_to(root).as_posix().encode())
+        h.update(path.read_bytes())
+    return h.hexdigest()[:12]
+
+
+def _load_reference(path: Path, starts: str, shift: float, names):
     """
-    (label, AO % per sequence of ``names`` and start) of the first tracker saved by --save.
+    (label, AO % per sequence of ``names`` and start, source) of the first tracker saved by --save.
+
+    Its source: the digest of the tracker sources it ran and when, as far as the file records them.
 
     SystemExit with one line for a file that is not such a run, or one of other starts or shift, or
     without a run of one of ``names``.
@@ -257,7 +280,11 @@ def _load_reference(path: Path, starts: str, shift: float, names) -> tuple[str, 
     missing = [n for n in names if n not in runs]
     if missing:
         raise SystemExit(f'--against {path}: no run of {", ".join(missing)}')
-    return label, np.array([runs[n] for n in names])
+    source = (
+        f'tracker sources {saved.get("tracker_sources", "not recorded")}, '
+        f'saved {saved.get("saved", "at an unrecorded time")}'
+    )
+    return label, np.array([runs[n] for n in names]), source
 
 
 if __name__ == '__main__':
