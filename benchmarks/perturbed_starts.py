@@ -258,7 +258,9 @@ def _tracker_digest() -> str:
     return h.hexdigest()[:12]
 
 
-def _load_reference(path: Path, starts: str, shift: float, names):
+def _load_reference(
+    path: Path, starts: str, shift: float, names
+) -> tuple[str, np.ndarray, str]:
     """
     (label, AO % per sequence of ``names`` and start, source) of the first tracker saved by --save.
 

@@ -260,11 +260,9 @@ def main(argv=None) -> int:
                 )
                 print(
                     f'  {s[0] / 60:6.2f} min  RSS {s[1]:7.1f} MB  CPU {cpu:6.1%}  sent {n}  '
-                    f'answered {s[2]}  with '
-                    'a detection '
-                    f'{s[3]}  tracker: received {seen["received"]} processed {seen["processed"]} '
-                    'dropped '
-                    f'{seen["dropped"]}, level {worst[0]} {worst[1][:80]}',
+                    f'answered {s[2]}  with a detection {s[3]}  tracker: received '
+                    f'{seen["received"]} processed {seen["processed"]} dropped {seen["dropped"]}, '
+                    f'level {worst[0]} {worst[1][:80]}',
                     flush=True,
                 )
         if proc.poll() is not None:
