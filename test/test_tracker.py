@@ -34,7 +34,6 @@ import threading
 from helpers import rotated, shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
-from iemd_ros.common.parallel import InlineExecutor
 from iemd_ros.datasets.otb import load_sequence, read_frame
 from iemd_ros.evaluation.metrics import iou
 from iemd_ros.tracking import tracker as tracker_module
@@ -547,23 +546,27 @@ def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
 
 def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, monkeypatch):
     """
-    Woman frames 1-24: the worker and learning threads give the boxes of one job after another.
+    Woman frames 1-24: the worker and learning threads give the boxes of ``threads=False``.
 
-    In the serial schedule every model runs when it is submitted, and the models have learned from
-    a frame when update returns.
+    Without threads every model runs when it is needed, in the caller's thread (the shared pools
+    are never asked for), and the models have learned from a frame when update returns.
     """
     seq = load_sequence(otb_root / 'Woman')
     frames = [read_frame(p) for p in seq.frame_paths[:25]]
 
-    def run():
-        tracker = IemdTracker()
+    def run(threads):
+        tracker = IemdTracker(threads=threads)
         tracker.init(frames[0], seq.gt_boxes[0])
         return [tracker.update(frame) for frame in frames[1:]]
 
-    threaded = run()
-    monkeypatch.setattr(tracker_module, '_workers', InlineExecutor)
-    monkeypatch.setattr(tracker_module, '_learner', InlineExecutor)
-    serial = run()
+    threaded = run(True)
+
+    def no_pool():
+        raise AssertionError('a tracker without threads asked for a thread pool')
+
+    monkeypatch.setattr(tracker_module, '_workers', no_pool)
+    monkeypatch.setattr(tracker_module, '_learner', no_pool)
+    serial = run(False)
     assert sum(not (r.lost or r.held) for r in serial) >= 20  # most frames learned
     assert [r.box for r in threaded] == [r.box for r in serial]
     assert [r.emd for r in threaded] == [r.emd for r in serial]

@@ -102,3 +102,29 @@ def test_the_pipeline_answers_a_frame_whose_update_hangs_and_tracks_the_next(mon
         assert p.statuses()[0].level == 0 and p.diagnostics()['updates_abandoned'] == 1
     finally:
         release.set()
+
+
+def test_an_offline_pipeline_waits_for_a_slow_update_in_the_callers_thread(monkeypatch):
+    """
+    ``live=False`` (the replay): no update is abandoned, however long it takes, and none leaves.
+
+    An update taking 3x ``watchdog_ms`` gives the frame its result; every tracker call runs in
+    the thread that called process.
+    """
+    seq = generate(n_frames=4, seed=3)
+    s = [int(v) for v in seq.frame_stamps_ns]
+    update, callers = IemdTracker.update, set()
+
+    def slow(self, frame, prior=None):
+        callers.add(threading.get_ident())
+        threading.Event().wait(0.3)
+        return update(self, frame, prior)
+
+    p = TrackingPipeline(PipelineConfig(use_gyro=False, watchdog_ms=100.0), live=False)
+    monkeypatch.setattr(IemdTracker, 'update', slow)
+    p.init(seq.frames[0], seq.gt_boxes[0], s[0])
+    for k in (1, 2, 3):
+        r = p.process(seq.frames[k], s[k])
+        assert r.state is TrackState.TRACKING and r.rejection is None
+    assert callers == {threading.get_ident()}
+    assert p.diagnostics()['updates_abandoned'] == 0 and p.statuses()[0].level == 0

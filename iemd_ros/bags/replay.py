@@ -34,8 +34,9 @@ Offline replay of a bag through the tracking pipeline, as fast as the CPU allows
 image, IMU and camera-info topics are auto-detected when the bag has one of each type, else named
 (:func:`iemd_ros.bags.io.select_topics`).  The messages go, in the bag's (log-time) order, through
 :class:`~iemd_ros.pipeline.TrackingPipeline` -- the same synchronization, gyro prediction and
-tracker as the node -- deterministically: nothing depends on the wall clock, so the same bag gives
-the same CSV byte for byte.
+tracker as the node -- deterministically: the pipeline runs offline (``live=False``: the tracker in
+this thread, no watchdog), nothing depends on the wall clock, so the same bag gives the same CSV
+byte for byte.
 
 IMU synchronization is the node's :class:`~iemd_ros.pipeline.ImuWait` on the bag's log times: a
 frame is held until the gyro covers it or until ``imu_wait_ms`` of bag time has passed after it (a
@@ -443,7 +444,9 @@ class Replay:
             self.topics = select_topics(self._reader, image_topic, imu_topic, camera_info_topic)
             cfg = config if config is not None else PipelineConfig()
             self.use_gyro = self._gyro_usable(bool(use_gyro and cfg.use_gyro))
-            self.pipeline = TrackingPipeline(replace(cfg, use_gyro=self.use_gyro), camera)
+            self.pipeline = TrackingPipeline(
+                replace(cfg, use_gyro=self.use_gyro), camera, live=False
+            )
         except BaseException:
             self._reader.close()
             raise

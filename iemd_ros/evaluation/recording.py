@@ -74,7 +74,7 @@ def track_recording(rec: Recording, start: int, stop: int, use_gyro: bool = True
         gyro=rec.gyro_config(),
         use_gyro=use_gyro,
     )
-    pipe = TrackingPipeline(cfg, camera=rec.camera)
+    pipe = TrackingPipeline(cfg, camera=rec.camera, live=False)
     if use_gyro:  # as the node gets them: one message at a time
         for t, w in zip(rec.imu_t_ns, rec.gyro):
             pipe.add_imu(int(t), w)

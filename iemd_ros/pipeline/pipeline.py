@@ -54,7 +54,9 @@ the camera, out of the image and back.
 
 Everything that decides a result depends only on the messages (stamps and contents), never on the
 wall clock, so replaying the same messages twice gives identical results; only
-``FrameResult.processing_ms`` and the ``*_ms`` diagnostic values are wall-clock measurements.
+``FrameResult.processing_ms`` and the ``*_ms`` diagnostic values are wall-clock measurements, and a
+live pipeline's watchdog, which abandons an update that overruns ``watchdog_ms`` (an offline one,
+``live=False``, has none).
 
 Thread safety: :meth:`add_imu`, :meth:`set_camera` and the ``note_*`` methods may be called from
 other threads while :meth:`process` runs; they never wait for a tracker update to finish.
@@ -162,10 +164,10 @@ class _Target:
         self.lost_since: int | None = None  # stamp of the first frame of the current lost run
         self.last_result: FrameResult | None = None
 
-    def restart(self, config) -> None:
-        """Restart the tracker at the window it holds, on the frame that window belongs to."""
+    def restart(self, tracker: IemdTracker) -> None:
+        """Restart at the window it holds with ``tracker``, on the frame that window is of."""
         _, box, frame = self.ref
-        self.tracker = IemdTracker(config)
+        self.tracker = tracker
         self.tracker.init(frame, box)
         self.state, self.lost_run, self.lost_since, self.window = (
             TrackState.TRACKING, 0, None, self.ref[:2])
@@ -184,6 +186,13 @@ class TrackingPipeline:
         Default ``PipelineConfig()``.
     camera : CameraModel, optional
         The calibration, if known (else :meth:`set_camera` later).
+    live : bool, optional
+        Frames arrive as they are taken (the node; default): the trackers learn after a result
+        has gone back and run a frame's models side by side on threads, and the ``watchdog_ms``
+        watchdog bounds each update.  False, for recorded frames processed back to back (the
+        replay): everything runs in the caller's thread and no update is abandoned, so no result
+        depends on the wall clock; the results are the same, at a higher frame rate
+        (docs/decisions.md#offline-inline).
 
     Raises
     ------
@@ -192,8 +201,15 @@ class TrackingPipeline:
 
     """
 
-    def __init__(self, config: PipelineConfig | None = None, camera: CameraModel | None = None):
+    def __init__(
+        self,
+        config: PipelineConfig | None = None,
+        camera: CameraModel | None = None,
+        *,
+        live: bool = True,
+    ):
         warm_up_kernels()
+        self.live = bool(live)
         self._cfg = config if config is not None else PipelineConfig()
         if not isinstance(self._cfg, PipelineConfig):
             raise ValueError('config must be a PipelineConfig')
@@ -338,7 +354,7 @@ class TrackingPipeline:
                 notes.append('gyro predictor rebuilt (IMU samples kept)')
             if config.tracker != old.tracker:
                 for target in self._targets.values():
-                    target.restart(config.tracker)
+                    target.restart(self._new_tracker())
                 notes.append(
                     'tracker restarted at its current window'
                     if self._targets
@@ -714,7 +730,7 @@ class TrackingPipeline:
         if not isinstance(target_id, str):
             raise ValueError(f'target_id must be text, got {target_id!r}')
         with self._track_lock:
-            tracker = IemdTracker(self._cfg.tracker)
+            tracker = self._new_tracker()
             tracker.init(frame, box)
             box = tuple(float(v) for v in box)
             with self._lock:
@@ -877,13 +893,19 @@ class TrackingPipeline:
                 target, frame, t, result, prior is not None, gyro_reason, gyro_box, ms
             )
 
+    def _new_tracker(self) -> IemdTracker:
+        """Return a tracker of the configured parameters, threaded when the pipeline is live."""
+        return IemdTracker(self._cfg.tracker, threads=self.live)
+
     def _update(self, target: _Target, frame, prior):
         """
-        Return the tracker's update, under the watchdog.
+        Return the tracker's update, under the watchdog when live.
 
         (:class:`Abandoned` when it overruns ``watchdog_ms``).
         """
         tracker = target.tracker
+        if not self.live:
+            return tracker.update(frame, prior=prior)
         return self._watchdog.run(
             lambda: tracker.update(frame, prior=prior), self._cfg.watchdog_ms / 1e3
         )
@@ -897,7 +919,7 @@ class TrackingPipeline:
         """
         t_ref, box, ref_frame = target.ref
         if exc.ran:
-            tracker = IemdTracker(self._cfg.tracker)
+            tracker = self._new_tracker()
             tracker.init(ref_frame, box)
             target.window = target.ref[:2]
             reason = (

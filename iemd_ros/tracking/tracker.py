@@ -52,6 +52,7 @@ import functools
 import cv2
 from iemd_ros.common.boxes import box_centre, centre_box, check_box
 from iemd_ros.common.limits import TARGET_SIDE
+from iemd_ros.common.parallel import InlineExecutor
 from iemd_ros.tracking.appearance import (
     grey_levels,
     ImagePyramid,
@@ -153,6 +154,12 @@ class IemdTracker:
     ----------
     config : TrackerConfig, optional
         The tracker's parameters (default: ``TrackerConfig()``, the ``default`` preset).
+    threads : bool, optional
+        Learn from a frame after :meth:`update` has returned, and run a frame's independent models
+        side by side, on threads shared by the process's trackers (default): the shortest wait for
+        each result, for frames that arrive live.  False runs everything in the caller's thread:
+        the same results, and more frames a second when they are processed back to back
+        (docs/decisions.md#offline-inline).
 
     Examples
     --------
@@ -162,10 +169,14 @@ class IemdTracker:
 
     """
 
-    def __init__(self, config: TrackerConfig | None = None):
+    def __init__(self, config: TrackerConfig | None = None, *, threads: bool = True):
         self.config = config if config is not None else TrackerConfig()
         if not isinstance(self.config, TrackerConfig):
             raise ValueError('config must be a TrackerConfig')
+        # where learning and a frame's independent models run
+        self._learner, self._workers = (
+            (_learner(), _workers()) if threads else (InlineExecutor(), InlineExecutor())
+        )
         cfg = self.config
         self.layout = PatchLayout(cfg.template_size, cfg.patch_size, cfg.patch_step)
         self._center = None
@@ -290,7 +301,7 @@ class IemdTracker:
         if visible >= cfg.min_visible:
             if cfg.flow_start:
                 box = _box(self._center, self._size, self._angle)
-                flow = _workers().submit(
+                flow = self._workers.submit(
                     window_flow, self._previous, grey, box, prior, cfg.flow_max_error
                 )
             if self._translation_filter is not None:
@@ -356,8 +367,8 @@ class IemdTracker:
         if held:
             cause, reason = Cause.LOW_RESPONSE, best.held_reason
         else:
-            # the result goes back now; the models learn on the learning thread meanwhile
-            self._learning = _learner().submit(
+            # with threads the result goes back now and the models learn meanwhile
+            self._learning = self._learner.submit(
                 self._learn, frame, final, best.confidence, new_center, new_size, angle
             )
         return TrackResult(
@@ -538,7 +549,7 @@ class IemdTracker:
         self._colour_now = self._colour_model is not None and frame.ndim == 3
         colour = None
         if self._colour_now:
-            colour = _workers().submit(self._colour_model.estimate, frame, center, size, angle)
+            colour = self._workers.submit(self._colour_model.estimate, frame, center, size, angle)
         filter_move = None if region is None else self._translation_filter.estimate(region)
         # the prediction's window is coded and solved here while the workers run
         context = self._context(pyramid, angle)
@@ -593,12 +604,10 @@ class IemdTracker:
                 if self._confidence is None
                 else ((1.0 - CONFIDENCE_RATE) * self._confidence + CONFIDENCE_RATE * confidence)
             )
-        # The scale filter and the colour model learn on the worker threads beside the filter.
-        pool, jobs = _workers(), []
-        if self._scale_filter is not None:
-            jobs.append(pool.submit(self._scale_filter.update, frame, center, size, angle))
-        if self._colour_now:
-            jobs.append(pool.submit(self._colour_model.update, frame, center, size, angle))
+        # The scale filter and the colour model learn on the workers beside the filter.
+        learners = [self._scale_filter.update] if self._scale_filter is not None else []
+        learners += [self._colour_model.update] if self._colour_now else []
+        jobs = [self._workers.submit(learn, frame, center, size, angle) for learn in learners]
         if self._translation_filter is not None:
             self._translation_filter.update(frame, center, size, angle)
         if self.config.update_templates and self.dictionary.observe(
