@@ -86,7 +86,8 @@ class PipelineConfig:
     watchdog_ms: float = param(
         2000.0,
         'a tracker update still running after this long is abandoned: the frame is '
-        'answered without a detection and the tracker rebuilt at its last good window',
+        'answered without a detection and the tracker rebuilt at its last good window '
+        '(the node; an offline replay waits for every update)',
         unit='ms',
         range=(100.0, 600_000.0),
         decision='watchdog',
