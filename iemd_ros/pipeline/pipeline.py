@@ -209,7 +209,7 @@ class TrackingPipeline:
         live: bool = True,
     ):
         warm_up_kernels()
-        self.live = bool(live)
+        self._live = bool(live)
         self._cfg = config if config is not None else PipelineConfig()
         if not isinstance(self._cfg, PipelineConfig):
             raise ValueError('config must be a PipelineConfig')
@@ -893,9 +893,14 @@ class TrackingPipeline:
                 target, frame, t, result, prior is not None, gyro_reason, gyro_box, ms
             )
 
+    @property
+    def live(self) -> bool:
+        """Whether frames are processed as they arrive (threads, watchdog); set at construction."""
+        return self._live
+
     def _new_tracker(self) -> IemdTracker:
         """Return a tracker of the configured parameters, threaded when the pipeline is live."""
-        return IemdTracker(self._cfg.tracker, threads=self.live)
+        return IemdTracker(self._cfg.tracker, threads=self._live)
 
     def _update(self, target: _Target, frame, prior):
         """
@@ -904,7 +909,7 @@ class TrackingPipeline:
         (:class:`Abandoned` when it overruns ``watchdog_ms``).
         """
         tracker = target.tracker
-        if not self.live:
+        if not self._live:
             return tracker.update(frame, prior=prior)
         return self._watchdog.run(
             lambda: tracker.update(frame, prior=prior), self._cfg.watchdog_ms / 1e3

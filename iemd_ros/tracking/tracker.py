@@ -174,9 +174,10 @@ class IemdTracker:
         if not isinstance(self.config, TrackerConfig):
             raise ValueError('config must be a TrackerConfig')
         # where learning and a frame's independent models run
-        self._learner, self._workers = (
-            (_learner(), _workers()) if threads else (InlineExecutor(), InlineExecutor())
-        )
+        if threads:
+            self._learner, self._workers = _learner(), _workers()
+        else:
+            self._learner = self._workers = InlineExecutor()
         cfg = self.config
         self.layout = PatchLayout(cfg.template_size, cfg.patch_size, cfg.patch_step)
         self._center = None
@@ -847,10 +848,10 @@ def warm_up() -> None:
     Then the first frames of a node or a replay are not spent compiling.
     """
     frame = (np.random.default_rng(0).random((64, 64)) * 255).astype(np.uint8)
-    tracker = IemdTracker()
+    # in this thread: warming starts no thread pool an offline process would not use
+    tracker = IemdTracker(threads=False)
     tracker.init(frame, (16, 16, 32, 32))
     tracker.update(frame)
-    tracker.wait_learned()
 
 
 # ---------------------------------------------------------------- helpers
