@@ -77,7 +77,9 @@ from iemd_ros.bags.replay import (
     DEBUG_IMAGE_TOPIC,
     DETECTIONS_TOPIC,
     DIAGNOSTICS_TOPIC,
+    OPENCV_THREADS,
     parse_box,
+    Replay,
     replay,
 )
 from iemd_ros.common.cli import split_ros_args
@@ -263,6 +265,29 @@ def test_gyro_matters_and_no_gyro(seq, bags):
     # the prior moves the search to the rotated target: a better mean overlap (the size of the gain
     # is the demo's figure, test_demo)
     assert np.mean(iou(with_g.boxes, seq.gt_boxes)) > np.mean(iou(without.boxes, seq.gt_boxes))
+
+
+def test_opencv_runs_single_threaded_during_a_replay_only(seq, bags, monkeypatch):
+    seen = []
+    process = Replay._process
+
+    def counting(self, frame):
+        seen.append(cv2.getNumThreads())
+        return process(self, frame)
+
+    monkeypatch.setattr(Replay, '_process', counting)
+    previous = cv2.getNumThreads()
+    cv2.setNumThreads(2)
+    try:
+        replay(bags / 'shaky', seq.gt_boxes[0])
+        assert len(seen) == N and set(seen) == {OPENCV_THREADS}
+        assert cv2.getNumThreads() == 2  # the caller's setting is back
+        # an init box the first image refuses fails the run after it started: restored too
+        with pytest.raises(ValueError, match='outside the 320x240 image'):
+            replay(bags / 'shaky', [400.0, 10.0, 20.0, 20.0])
+        assert len(seen) == N + 1 and cv2.getNumThreads() == 2
+    finally:
+        cv2.setNumThreads(previous)
 
 
 def test_formats_agree(seq, bags, tmp_path):
