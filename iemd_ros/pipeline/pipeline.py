@@ -255,7 +255,7 @@ class TrackingPipeline:
             'camera_misfit': '',
             'watchdog_reason': '',
         }
-        self._watchdog = Watchdog()
+        self._watchdog = Watchdog() if self._live else None  # offline updates are not bounded
         self._last_result: FrameResult | None = None  # the latest tracked result of any target
         self._image_bad = False  # the latest image message was malformed
         self._stamp_rejected = False  # the latest frame was rejected for its stamp
