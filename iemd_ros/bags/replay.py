@@ -60,7 +60,6 @@ input's image with the annotations drawn over it), and an annotated MP4 (``mp4v`
 from __future__ import annotations
 
 from collections import deque
-from contextlib import contextmanager
 import csv
 from dataclasses import dataclass, field, replace
 import math
@@ -128,17 +127,6 @@ HARDWARE_ID = 'iemd_replay'
 # OpenCV's threads while a replay runs: the tracker runs in this thread, and OpenCV's pool only
 # adds synchronization to its small calls (docs/decisions.md#replay-opencv-threads)
 OPENCV_THREADS = 1
-
-
-@contextmanager
-def _opencv_threads(n: int):
-    """Set OpenCV's thread count to ``n`` inside the block; restore it after."""
-    previous = cv2.getNumThreads()
-    cv2.setNumThreads(n)
-    try:
-        yield
-    finally:
-        cv2.setNumThreads(previous)
 
 
 @dataclass
@@ -528,34 +516,35 @@ class Replay:
         )
         self._out = _OutBag(out_bag, self.topics.image) if out_bag is not None else None
         self._video = _Video(video) if video is not None else None
-        with _opencv_threads(OPENCV_THREADS):
-            t_start = time.perf_counter()
-            try:
-                self._feed()
-                self._bar.close()
-                wall = time.perf_counter() - t_start
-                if self.pipeline.state is TrackState.UNINITIALIZED and not self._dropped:
-                    first = self._results[0].reason if self._results else 'the topic is empty'
-                    raise BagError(
-                        f'no image on {self.topics.image!r} of {self.bag} could be decoded: '
-                        f'{first}'
-                    )
-                if (
-                    self.use_gyro
-                    and self.pipeline.counters['camera_infos'] == 0
-                    and self._camera is None
-                ):
-                    self._note('no usable camera info in the bag: tracked without the gyro prior')
-                if csv_path is not None:
-                    write_csv(csv_path, self._results)
-                self._close_outputs(None)
-            except BaseException as exc:
-                self._close_outputs(type(exc))
-                if video is not None:
-                    Path(video).unlink(missing_ok=True)
-                raise
-            finally:
-                self._reader.close()
+        opencv_threads = cv2.getNumThreads()  # the caller's, restored below
+        cv2.setNumThreads(OPENCV_THREADS)
+        t_start = time.perf_counter()
+        try:
+            self._feed()
+            self._bar.close()
+            wall = time.perf_counter() - t_start
+            if self.pipeline.state is TrackState.UNINITIALIZED and not self._dropped:
+                first = self._results[0].reason if self._results else 'the topic is empty'
+                raise BagError(
+                    f'no image on {self.topics.image!r} of {self.bag} could be decoded: {first}'
+                )
+            if (
+                self.use_gyro
+                and self.pipeline.counters['camera_infos'] == 0
+                and self._camera is None
+            ):
+                self._note('no usable camera info in the bag: tracked without the gyro prior')
+            if csv_path is not None:
+                write_csv(csv_path, self._results)
+            self._close_outputs(None)
+        except BaseException as exc:
+            self._close_outputs(type(exc))
+            if video is not None:
+                Path(video).unlink(missing_ok=True)
+            raise
+        finally:
+            self._reader.close()
+            cv2.setNumThreads(opencv_threads)
         return ReplayResult(
             str(self.bag),
             self.topics,

@@ -893,11 +893,6 @@ class TrackingPipeline:
                 target, frame, t, result, prior is not None, gyro_reason, gyro_box, ms
             )
 
-    @property
-    def live(self) -> bool:
-        """Whether frames are processed as they arrive (threads, watchdog); set at construction."""
-        return self._live
-
     def _new_tracker(self) -> IemdTracker:
         """Return a tracker of the configured parameters, threaded when the pipeline is live."""
         return IemdTracker(self._cfg.tracker, threads=self._live)
