@@ -162,8 +162,8 @@ def test_the_score_weighs_the_filter_response_against_the_emd(car4_first, monkey
 
     The search keeps the descended window of lowest EMD / background EMD - translation_weight x
     response.  A stand-in filter points at a decoy 30 px right of the target's true move (9, -6)
-    and responds only there: with a negligible weight the EMD's window on the target is kept, with
-    weight 1 the decoy's.
+    and responds only there (its own estimate still runs, for the response's peak and APCE): with a
+    negligible weight the EMD's window on the target is kept, with weight 1 the decoy's.
     """
     frame, box = car4_first
     moved = shifted(frame, 9.0, -6.0)
@@ -172,8 +172,11 @@ def test_the_score_weighs_the_filter_response_against_the_emd(car4_first, monkey
     for weight in (1e-6, 1.0):
         tracker = IemdTracker(TrackerConfig(translation_weight=weight, update_templates=False))
         tracker.init(frame, box)
+        estimate = tracker._translation_filter.estimate
         monkeypatch.setattr(
-            tracker._translation_filter, 'estimate', lambda region: decoy - region.center
+            tracker._translation_filter,
+            'estimate',
+            lambda region, estimate=estimate: (estimate(region), decoy - region.center)[1],
         )
         monkeypatch.setattr(
             tracker._translation_filter,

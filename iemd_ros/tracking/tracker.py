@@ -34,7 +34,9 @@ Algorithm 1 with the extensions of sections 5.1 and 6.1 and discriminative model
 
 OpenCV-style API: ``init(frame, box)`` then ``update(frame, prior=None)``.
 
-Per frame: the starts (the prediction, the optical flow's, the translation filter's and the colour
+Per frame: where the translation filter's response is of high confidence by LMCF's test (its peak
+and APCE both near their means over the frames that learned), the filter's peak is the only start;
+otherwise the starts (the prediction, the optical flow's, the translation filter's and the colour
 model's windows) are compared by the EMD between their sparse-coding histograms and the target's
 and by the search's score; with ``n_iter`` > 0 the best by EMD and the best by score are descended
 (Algorithm 1: move against the EMD's gradient while it decreases; the ``paper`` preset descends,
@@ -81,6 +83,10 @@ FRAME_SEARCH_AFTER = 5
 # re-detection's other sizes, relative to the lost window's, one per lost frame in turn: TLD's
 # scanning grid steps the size by 1.2 (Kalal et al., TPAMI 2012, section 5.3)
 REDETECT_SIZES = (1.2**-2, 1.2**-1, 1.2, 1.2**2)
+# LMCF's high-confidence test (Wang et al., CVPR 2017, section 3.3): the filter's peak and its APCE
+# at least these fractions of their means over the frames that learned (its beta_1 and beta_2)
+CONFIDENT_PEAK = 0.7
+CONFIDENT_APCE = 0.45
 
 
 class Cause(enum.Enum):
@@ -189,6 +195,7 @@ class IemdTracker:
         self._frame_index = 0
         self._lost = False
         self._confidence = None
+        self._peak_apce_sums, self._peak_apce_count, self._peak_apce = np.zeros(2), 0, None
         self._learning = None  # the models' learning from the last tracked frame (a Future)
 
     # ------------------------------------------------------------------ API
@@ -245,6 +252,9 @@ class IemdTracker:
         self._lost = False
         # running mean of the filter's response at the window over frames that learned
         self._confidence = None
+        # sums of the filter's (peak, APCE) over the frames that learned, and their count
+        self._peak_apce_sums, self._peak_apce_count = np.zeros(2), 0
+        self._peak_apce = None  # this frame's (peak, APCE), learned from if the frame is tracked
         # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
         self._search_part = 0
         self._lost_frames = 0  # lost frames in a row
@@ -294,20 +304,26 @@ class IemdTracker:
             angle = _wrap_angle(angle + turn)
             anchor = None if anchor is None else _apply_prior(prior, anchor, size)[0]
         cfg = self.config
-        # what needs no model (grey levels, pyramid, flow, the filter's sample) runs while the
-        # models still learn from the last frame
+        # what needs no model (grey levels, pyramid, the filter's sample) runs while the models
+        # still learn from the last frame
         grey, pyramid = self._take_frame(frame)
         visible = _visible_fraction(center, size, angle, frame.shape)
-        flow = region = None
-        if visible >= cfg.min_visible:
-            if cfg.flow_start:
-                box = _box(self._center, self._size, self._angle)
-                flow = self._workers.submit(
-                    window_flow, self._previous, grey, box, prior, cfg.flow_max_error
-                )
-            if self._translation_filter is not None:
-                region = self._translation_filter.sample(frame, center, size, angle)
+        flow = filter_move = self._peak_apce = None
+        filtering = visible >= cfg.min_visible and self._translation_filter is not None
+        if filtering:
+            region = self._translation_filter.sample(frame, center, size, angle)
         self.wait_learned()
+        if filtering:
+            filter_move = self._translation_filter.estimate(region)
+            confidence = self._translation_filter.confidence
+            self._peak_apce = np.array([confidence['peak'], confidence['apce']])
+        confident = self._filter_confident()
+        # the flow is a start of the search, which a confident filter's peak makes unneeded
+        if visible >= cfg.min_visible and cfg.flow_start and not confident:
+            box = _box(self._center, self._size, self._angle)
+            flow = self._workers.submit(
+                window_flow, self._previous, grey, box, prior, cfg.flow_max_error
+            )
         self._previous = grey if cfg.flow_start else None
         self._frame_index += 1
         self._anchor, self._prediction = anchor, center
@@ -328,7 +344,7 @@ class IemdTracker:
                 f'only {visible:.0%} of the predicted window is inside the image',
             )
         best, searches, starts = self._search_all(
-            frame, flow, region, pyramid, center, size, angle
+            frame, flow, filter_move, confident, pyramid, center, size, angle
         )
         # held or lost: the window keeps its size
         final, scale = _Descent(model=best.model, emd=best.emd), 1.0
@@ -368,6 +384,9 @@ class IemdTracker:
         if held:
             cause, reason = Cause.LOW_RESPONSE, best.held_reason
         else:
+            if self._peak_apce is not None:
+                self._peak_apce_sums += self._peak_apce
+                self._peak_apce_count += 1
             # with threads the result goes back now and the models learn meanwhile
             self._learning = self._learner.submit(
                 self._learn, frame, final, best.confidence, new_center, new_size, angle
@@ -537,23 +556,37 @@ class IemdTracker:
         tf = self._translation_filter
         return at + tf.estimate(tf.sample(frame, at, size, angle)), tf.response_peak
 
-    def _search_all(self, frame, flow, region, pyramid, center, size, angle):
+    def _filter_confident(self) -> bool:
+        """
+        Whether this frame's translation filter estimate passes LMCF's high-confidence test.
+
+        Its peak at least ``CONFIDENT_PEAK`` and its APCE at least ``CONFIDENT_APCE`` times their
+        means over the frames that learned; not without an estimate or before any such frame.
+        """
+        if self._peak_apce is None or not self._peak_apce_count:
+            return False
+        means = self._peak_apce_sums / self._peak_apce_count
+        return bool(np.all(self._peak_apce >= [CONFIDENT_PEAK, CONFIDENT_APCE] * means))
+
+    def _search_all(self, frame, flow, filter_move, confident, pyramid, center, size, angle):
         """
         (best descent, every search run, starts searched) from the prediction ``center``.
 
-        The fine starts (the flow's, a Future or None; the translation filter's on its sampled
-        ``region``; the colour model's) and, when the frame looks lost, section 6.1's particles.
+        With the translation filter ``confident``, its peak (``center + filter_move``) alone;
+        otherwise the fine starts (the flow's, a Future or None; the filter's; the colour model's)
+        and, when the frame looks lost, section 6.1's particles.
         """
         cfg = self.config
-        # Where the translation filter and the colour model take the window: independent, so the
-        # colour model runs on a worker thread (beside the flow) while the filter runs here.
         self._colour_now = self._colour_model is not None and frame.ndim == 3
+        context = self._context(pyramid, angle)
+        if confident:
+            best = self._search([CandidateModel(context, center + filter_move, size)], center)
+            return best, [best], 1
+        # the colour model's window runs on a worker thread (beside the flow's)
         colour = None
         if self._colour_now:
             colour = self._workers.submit(self._colour_model.estimate, frame, center, size, angle)
-        filter_move = None if region is None else self._translation_filter.estimate(region)
         # the prediction's window is coded and solved here while the workers run
-        context = self._context(pyramid, angle)
         predicted = CandidateModel(context, center, size)
         predicted.emd()
         moves = [flow.result() if flow else None, filter_move, colour.result() if colour else None]
