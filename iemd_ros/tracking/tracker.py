@@ -309,7 +309,8 @@ class IemdTracker:
         grey, pyramid = self._take_frame(frame)
         visible = _visible_fraction(center, size, angle, frame.shape)
         flow = filter_move = self._peak_apce = None
-        filtering = visible >= cfg.min_visible and self._translation_filter is not None
+        in_view = visible >= cfg.min_visible
+        filtering = in_view and self._translation_filter is not None
         if filtering:
             region = self._translation_filter.sample(frame, center, size, angle)
         self.wait_learned()
@@ -319,7 +320,7 @@ class IemdTracker:
             self._peak_apce = np.array([confidence['peak'], confidence['apce']])
         confident = self._filter_confident()
         # the flow is a start of the search, which a confident filter's peak makes unneeded
-        if visible >= cfg.min_visible and cfg.flow_start and not confident:
+        if in_view and cfg.flow_start and not confident:
             box = _box(self._center, self._size, self._angle)
             flow = self._workers.submit(
                 window_flow, self._previous, grey, box, prior, cfg.flow_max_error
@@ -329,7 +330,7 @@ class IemdTracker:
         self._anchor, self._prediction = anchor, center
         predicted = _box(center, size, angle)
         # the prior moved the window out of view: keep its place, search only the frame
-        if visible < cfg.min_visible:
+        if not in_view:
             redetected = (
                 self._redetect(frame, pyramid, size, angle, predicted, 0, 0)
                 if self._lost
