@@ -528,6 +528,18 @@ def test_a_window_started_too_large_never_outgrows_the_image(otb_root):
     assert max(areas) <= width * height * (1 + 1e-9)
 
 
+def _overlaps_from_the_ground_truth(folder, n: int) -> list[float]:
+    """IoU with the ground truth of each of frames 1..n-1 of a sequence, tracked from frame 0."""
+    seq = load_sequence(folder)
+    frames = [read_frame(path) for path in seq.frame_paths[:n]]
+    tracker = IemdTracker()
+    tracker.init(frames[0], seq.gt_boxes[0])
+    return [
+        float(iou(tracker.update(frame).box, seq.gt_boxes[k]).ravel()[0])
+        for k, frame in enumerate(frames[1:], start=1)
+    ]
+
+
 def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
     """
     building5 (UAV123@10fps, 1280x720), frames 1-100 from the ground truth.
@@ -535,14 +547,7 @@ def test_a_person_seen_from_a_drone_is_tracked_through_a_real_excerpt(uav_root):
     A walking person of about 22x62 px seen from a drone that moves.  Bound: mean IoU at least 0.75
     and no frame below 0.5 (docs/decisions.md#strcf).
     """
-    seq = load_sequence(uav_root / 'building5')
-    frames = [read_frame(path) for path in seq.frame_paths[:100]]
-    tracker = IemdTracker()
-    tracker.init(frames[0], seq.gt_boxes[0])
-    overlaps = [
-        float(iou(tracker.update(frame).box, seq.gt_boxes[k]).ravel()[0])
-        for k, frame in enumerate(frames[1:], start=1)
-    ]
+    overlaps = _overlaps_from_the_ground_truth(uav_root / 'building5', 100)
     assert np.mean(overlaps) >= 0.75 and min(overlaps) >= 0.5, (np.mean(overlaps), min(overlaps))
 
 
@@ -554,14 +559,7 @@ def test_a_mountain_biker_seen_from_a_drone_is_tracked_through_a_real_excerpt(ua
     flow's and the filter's starts are on him while the EMD prefers the prediction.  Bound: mean
     IoU at least 0.65 and no frame below 0.5 (docs/decisions.md#filter-confident-start).
     """
-    seq = load_sequence(uav_root / 'MountainBike6')
-    frames = [read_frame(path) for path in seq.frame_paths[:21]]
-    tracker = IemdTracker()
-    tracker.init(frames[0], seq.gt_boxes[0])
-    overlaps = [
-        float(iou(tracker.update(frame).box, seq.gt_boxes[k]).ravel()[0])
-        for k, frame in enumerate(frames[1:], start=1)
-    ]
+    overlaps = _overlaps_from_the_ground_truth(uav_root / 'MountainBike6', 21)
     assert np.mean(overlaps) >= 0.65 and min(overlaps) >= 0.5, (np.mean(overlaps), min(overlaps))
 
 
