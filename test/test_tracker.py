@@ -529,7 +529,7 @@ def test_a_window_started_too_large_never_outgrows_the_image(otb_root):
 
 
 def _overlaps_from_the_ground_truth(folder, n: int) -> list[float]:
-    """IoU with the ground truth of each of frames 1..n-1 of a sequence, tracked from frame 0."""
+    """Return the IoU with the ground truth of frames 1..n-1, tracked from frame 0."""
     seq = load_sequence(folder)
     frames = [read_frame(path) for path in seq.frame_paths[:n]]
     tracker = IemdTracker()
