@@ -486,11 +486,11 @@ class IemdTracker:
         lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near where it
         happened), one strip of the whole frame (the frame is scanned over lost frames) refined by
         a search at its peak.  Where no peak reaches ``found_response`` times the running mean, the
-        filter searches those places again at one other size of ``REDETECT_SIZES`` (a target may
-        come back nearer or farther); a window found so keeps the lost size unless its EMD is lower
-        at the other (the paper's scale rule, section 6.1).  The result when the best peak reaches
-        ``found_response`` times the running mean and its window's EMD is below the lost limit,
-        else None.  Nothing learns from the frame.
+        filter searches the place of the highest again at one other size of ``REDETECT_SIZES`` (a
+        target may come back nearer or farther); a window found so keeps the lost size unless its
+        EMD is lower at the other (the paper's scale rule, section 6.1).  The result when the best
+        peak reaches ``found_response`` times the running mean and its window's EMD is below the
+        lost limit, else None.  Nothing learns from the frame.
         """
         tf, cfg = self._translation_filter, self.config
         # no frame learned yet: no response to compare a candidate with
@@ -511,11 +511,11 @@ class IemdTracker:
         factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
         if candidates and factor != 1.0:
             other = size * factor
-            peaks = [
-                self._filter_peak(frame, place, other, angle)
-                for place, _ in candidates
-                if _visible_fraction(place, other, angle, frame.shape) >= cfg.min_visible
-            ]
+            peaks = (
+                [self._filter_peak(frame, found, other, angle)]
+                if _visible_fraction(found, other, angle, frame.shape) >= cfg.min_visible
+                else []
+            )
             searched += len(peaks)
             found, peak = max(peaks, key=lambda c: c[1], default=(None, -np.inf))
         if peak < wanted:
