@@ -123,8 +123,11 @@ class ColourModel:
             The window's turn, radians.
 
         """
-        self._target, self._surroundings = self._histograms(frame, center, size, angle)
-        self._beta = _beta(self._target, self._surroundings)
+        target, surroundings = self._histograms(frame, center, size, angle)
+        # blended in at rate 1: the first window's fractions themselves, and their beta
+        self._target, self._surroundings, self._beta = _blend(
+            target, surroundings, target, surroundings, 1.0
+        )
         self._means = None
 
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
@@ -144,10 +147,9 @@ class ColourModel:
 
         """
         target, surroundings = self._histograms(frame, center, size, angle)
-        eta = self.learning_rate
-        self._target = (1.0 - eta) * self._target + eta * target
-        self._surroundings = (1.0 - eta) * self._surroundings + eta * surroundings
-        self._beta = _beta(self._target, self._surroundings)
+        self._target, self._surroundings, self._beta = _blend(
+            self._target, self._surroundings, target, surroundings, self.learning_rate
+        )
 
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
         """
@@ -241,14 +243,8 @@ class ColourModel:
         """
         size = np.asarray(size, dtype=np.float64)
         bins, scale = self._bin_indices(frame, center, size + 0.5 * (size[0] + size[1]), angle)
-        h, w = bins.shape
-        ys, xs = np.abs(np.arange(h) - (h - 1) / 2.0), np.abs(np.arange(w) - (w - 1) / 2.0)
         half = size * scale / 2.0
-        inside = (ys[:, None] <= half[1]) & (xs[None, :] <= half[0])
-        n = self.bins**3
-        target = np.bincount(bins[inside], minlength=n).astype(np.float64)
-        surroundings = np.bincount(bins[~inside], minlength=n).astype(np.float64)
-        return target / max(target.sum(), 1.0), surroundings / max(surroundings.sum(), 1.0)
+        return _fractions(bins, float(half[0]), float(half[1]), self.bins**3)
 
     def _bin_indices(self, frame, center, region, angle) -> tuple[np.ndarray, float]:
         """
@@ -279,7 +275,43 @@ def _bin_index(sample, shift, bins):
     return out
 
 
-def _beta(target: np.ndarray, surroundings: np.ndarray) -> np.ndarray:
-    """Staple's per-bin score rho_O / (rho_O + rho_B), 0 where neither histogram has the bin."""
-    total = target + surroundings
-    return np.divide(target, total, out=np.zeros_like(total), where=total > 0)
+@numba.njit(cache=True, nogil=True)
+def _fractions(bins, half_w, half_h, n):
+    """
+    (rho_O, rho_B): the fractions of the pixels in each of ``n`` bins, in and around the window.
+
+    ``bins`` is the (h, w) bin map of the region centred on the window; a pixel is in the window
+    when it is at most ``half_w`` and ``half_h`` px from the region's centre.
+    """
+    h, w = bins.shape
+    target, surroundings = np.zeros(n), np.zeros(n)
+    inside = 0
+    for y in range(h):
+        in_rows = abs(y - (h - 1) / 2.0) <= half_h
+        for x in range(w):
+            if in_rows and abs(x - (w - 1) / 2.0) <= half_w:
+                target[bins[y, x]] += 1.0
+                inside += 1
+            else:
+                surroundings[bins[y, x]] += 1.0
+    target /= max(float(inside), 1.0)
+    surroundings /= max(float(h * w - inside), 1.0)
+    return target, surroundings
+
+
+@numba.njit(cache=True, nogil=True)
+def _blend(target, surroundings, new_target, new_surroundings, eta):
+    """
+    (rho_O, rho_B, beta) after blending the new fractions in at rate ``eta``.
+
+    Staple's running averages and its per-bin score beta = rho_O / (rho_O + rho_B) (0 where
+    neither histogram has the bin), in one pass over the bins.
+    """
+    n = target.size
+    t_out, s_out, beta = np.empty(n), np.empty(n), np.empty(n)
+    for i in range(n):
+        t = (1.0 - eta) * target[i] + eta * new_target[i]
+        s = (1.0 - eta) * surroundings[i] + eta * new_surroundings[i]
+        t_out[i], s_out[i] = t, s
+        beta[i] = t / (t + s) if t + s > 0 else 0.0
+    return t_out, s_out, beta
