@@ -32,7 +32,11 @@ Staple's colour histograms.
 
 The per-pixel score beta, the window means, the start and the tracker's use.
 """
-from helpers import shifted, texture
+import os
+import subprocess
+import sys
+
+from helpers import REPO, shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.datasets.otb import load_sequence, read_frame
@@ -179,3 +183,25 @@ def test_tracks_a_real_colour_otb_excerpt(otb_root):
     overlap = iou(np.array([seq.gt_boxes[0]] + [r.box for r in results]), seq.gt_boxes[:100])
     assert max(r.starts for r in results) == 4
     assert overlap.mean() > 0.7, overlap.mean()
+
+
+def test_the_warm_up_compiles_the_colour_models_kernels():
+    """
+    ``warm_up`` (``iemd-compile``, a pipeline's start) tracks a colour frame too.
+
+    In a process of its own, after ``warm_up`` alone, the colour model's kernels are compiled (or
+    loaded): a fresh install's first colour frame compiles nothing
+    (docs/decisions.md#colour-model-kernels).
+    """
+    code = (
+        'from iemd_ros.tracking import colour_model as c, tracker as t; t.warm_up(); '
+        'print(all(k.signatures for k in (c._bin_index, c._fractions, c._blend)))'
+    )
+    done = subprocess.run(
+        [sys.executable, '-c', code],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, 'PYTHONPATH': str(REPO)},
+    )
+    assert done.stdout.strip() == 'True', (done.stdout, done.stderr)
