@@ -881,9 +881,9 @@ def warm_up() -> None:
 
     Then the first frames of a node or a replay are not spent compiling.
     """
-    # a grey frame and a colour one: the colour model and the Colour Names run on colour only
+    # a grey frame and a colour one (the colour model runs on colour frames only)
     colour = (np.random.default_rng(0).random((64, 64, 3)) * 255).astype(np.uint8)
-    for frame in (colour[..., 0], colour):
+    for frame in (np.ascontiguousarray(colour[..., 0]), colour):
         # in this thread: warming starts no thread pool an offline process would not use
         tracker = IemdTracker(threads=False)
         tracker.init(frame, (16, 16, 32, 32))
