@@ -141,8 +141,17 @@ def run_module(module: str, *args: str, timeout: float = 120, **kw) -> subproces
 
     (text output captured).
     """
+    return run_python('-m', module, *args, timeout=timeout, **kw)
+
+
+def run_python(*args: str, timeout: float = 120, **kw) -> subprocess.CompletedProcess:
+    """
+    ``python args...`` (``-c code``, ``-m module``) as its own process on the repository's sources.
+
+    (text output captured).
+    """
     return subprocess.run(
-        [sys.executable, '-m', module, *args],
+        [sys.executable, *args],
         capture_output=True,
         text=True,
         timeout=timeout,

@@ -32,11 +32,7 @@ Staple's colour histograms.
 
 The per-pixel score beta, the window means, the start and the tracker's use.
 """
-import os
-import subprocess
-import sys
-
-from helpers import REPO, shifted, texture
+from helpers import run_python, shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.datasets.otb import load_sequence, read_frame
@@ -197,11 +193,5 @@ def test_the_warm_up_compiles_the_colour_models_kernels():
         'from iemd_ros.tracking import colour_model as c, tracker as t; t.warm_up(); '
         'print(all(k.signatures for k in (c._bin_index, c._fractions, c._blend)))'
     )
-    done = subprocess.run(
-        [sys.executable, '-c', code],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, 'PYTHONPATH': str(REPO)},
-    )
+    done = run_python('-c', code, timeout=300)
     assert done.stdout.strip() == 'True', (done.stdout, done.stderr)
