@@ -210,3 +210,44 @@ def test_search_frame_finds_the_target_moved_anywhere_in_a_drone_frame(uav_root)
             (tf.search_frame(moved, box[2:], part) for part in range(parts)), key=lambda r: r[1]
         )[0]
         assert np.linalg.norm(found - (box_centre(box) + move)) < 1.5 * cell_px, (move, found)
+
+
+def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, monkeypatch):
+    """
+    Each strip's response is the filter's linear correlation over it, done directly.
+
+    building5's first 1280x720 frame at a scale with several strips (the first and last cut by
+    the frame's edges): the strip's features correlated with the spatial filter channel by channel
+    by ``scipy.signal.correlate`` (zero outside the strip), kept over the strip's own cells inside
+    the frame; the FFT's wrap may touch none of them.  ``search_frame`` is its peak.
+    """
+    from iemd_ros.datasets.otb import read_frame, load_sequence
+    from scipy import fft as sfft, signal
+
+    seq = load_sequence(uav_root / 'building5')
+    frame, box = read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0], float)
+    tf = _learned(frame, box)
+    size = box[2:] * 0.5  # the frame at a larger scale: more strips
+    strips = []
+    extract = features.extract
+    monkeypatch.setattr(features, 'extract', lambda *a: strips.append(extract(*a)) or strips[-1])
+    parts = tf.frame_response(frame, size, 0)[3]
+    assert parts >= 3
+    n, c0 = tf.map_hw[0], tf.map_hw[0] // 2
+    h = sfft.irfft2(tf.f, s=tf.map_hw, axes=(1, 2))
+    for part in range(parts):
+        strips.clear()
+        resp, first, cell_px, _ = tf.frame_response(frame, size, part)
+        z = strips[0]
+        lo = max(first - c0, 0)
+        direct = sum(signal.correlate(z[c], h[c], mode='full') for c in range(len(z)))
+        # full[p, q] is the shift (p - n + 1, q - n + 1); cell i answers at shift i - c0
+        rows, cols = resp.shape
+        kept = direct[n - 1 - c0:][:rows, n - 1 - c0 + first - lo:][:, :cols]
+        assert kept.shape == resp.shape and rows * cell_px[1] == pytest.approx(frame.shape[0])
+        np.testing.assert_allclose(resp, kept, rtol=0, atol=1e-5 * np.abs(kept).max())
+        centre, value, _ = tf.search_frame(frame, size, part)
+        k = np.unravel_index(np.argmax(resp), resp.shape)
+        assert value == resp[k]
+        np.testing.assert_allclose(centre, (np.array([k[1] + first, k[0]]) + 0.5) * cell_px - 0.5)
+    assert first + cols == int(frame.shape[1] / cell_px[0] + 0.5)  # the last strip ends at the edge

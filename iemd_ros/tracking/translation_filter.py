@@ -236,13 +236,9 @@ class TranslationFilter:
         """
         Where in one part of ``frame`` the filter responds most.
 
-        The filter is taken at the scale of a window of ``size``.
-
-        The frame is resampled to the filter's scale and cut into vertical strips of at most
-        ``FRAME_SEARCH_CELLS`` feature cells; the strip's features are correlated with the spatial
-        filter, zero-padded so that the correlation is linear, not circular (the strip is read with
-        a margin of half the filter on each side).  A caller scans the whole frame by asking for
-        parts 0, 1, ... over several frames.
+        The filter is taken at the scale of a window of ``size``; the response is
+        :meth:`frame_response`'s.  A caller scans the whole frame by asking for parts 0, 1, ...
+        over several frames.
 
         Parameters
         ----------
@@ -264,6 +260,47 @@ class TranslationFilter:
             How many strips the frame has at this scale.
 
         """
+        resp, first, cell_px, parts = self.frame_response(frame, size, part)
+        k = np.unravel_index(int(np.argmax(resp)), resp.shape)
+        centre = (np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5) * cell_px - 0.5
+        return centre, float(resp[k]), parts
+
+    def frame_response(
+        self, frame: np.ndarray, size, part: int = 0
+    ) -> tuple[np.ndarray, int, np.ndarray, int]:
+        """
+        The filter's response over one vertical strip of ``frame``, at the scale of ``size``.
+
+        The frame is resampled to the filter's scale and cut into vertical strips of at most
+        ``FRAME_SEARCH_CELLS`` feature cells.  The strip's features, read with a margin of half
+        the filter on each side, are correlated with the spatial filter so that the response is
+        linear, not circular, over the strip's own cells: zero-padded by the filter's size down
+        the frame, and across by the filter's size beyond the strip's own width (overlap-save: the
+        margins wrap only into cells not returned).
+
+        Parameters
+        ----------
+        frame : ndarray
+            The frame.
+        size : array_like
+            The window's size (w, h), px: the scale the frame is resampled to.
+        part : int
+            Which strip (taken modulo the number of strips).
+
+        Returns
+        -------
+        response : ndarray
+            (rows, cols) response at the strip's cells inside the frame; a cell answers for a
+            target centred on it.
+        first : int
+            The frame's cell column of the response's first column.
+        cell_px : ndarray
+            (x, y) size of a cell in frame pixels: cell (i, j) is centred at
+            ``((j + first, i) + 0.5) * cell_px - 0.5``.
+        parts : int
+            How many strips the frame has at this scale.
+
+        """
         scale = self._scale(size)
         rows, cols = frame.shape[:2]
         cells = (
@@ -277,17 +314,16 @@ class TranslationFilter:
         n, c0 = self.map_hw[0], self.map_hw[0] // 2
         first = (part % parts) * width
         lo, hi = max(first - c0, 0), min(first + width + c0, cells[1])
-        ratio = np.array([cols / (cells[1] * features.CELL), rows / (cells[0] * features.CELL)])
+        cell_px = np.array([cols / cells[1], rows / cells[0]])
         strip = sample_region(
             frame,
-            ((lo + hi) * features.CELL / 2 * ratio[0] - 0.5, rows / 2 - 0.5),
-            ((hi - lo) * features.CELL * ratio[0], rows),
+            ((lo + hi) / 2 * cell_px[0] - 0.5, rows / 2 - 0.5),
+            ((hi - lo) * cell_px[0], rows),
             ((hi - lo) * features.CELL, cells[0] * features.CELL),
         )
         z = features.extract(strip, self.colour)
-        # zero-padded to at least the strip plus the filter (linear correlation), at sizes the FFT
-        # factors well
-        shape = tuple(sfft.next_fast_len(k, real=True) for k in (cells[0] + n, hi - lo + n))
+        # sizes the FFT factors well
+        shape = tuple(sfft.next_fast_len(k, real=True) for k in (cells[0] + n, width + n))
         if (
             self._frame_filter is None
             or self._frame_filter[0] is not self.f
@@ -298,13 +334,9 @@ class TranslationFilter:
             self._frame_filter = (self.f, shape, np.conj(sfft.rfft2(h, s=shape, axes=(1, 2))))
         resp_f = np.sum(self._frame_filter[2] * sfft.rfft2(z, s=shape, axes=(1, 2)), axis=0)
         resp = np.roll(sfft.irfft2(resp_f, s=shape), (c0, c0), axis=(0, 1))[
-            :cells[0], first - lo:first - lo + width
+            :cells[0], first - lo:min(first + width, cells[1]) - lo
         ]
-        k = np.unravel_index(int(np.argmax(resp)), resp.shape)
-        centre = (
-            np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5
-        ) * features.CELL * ratio - 0.5
-        return centre, float(resp[k]), parts
+        return resp, first, cell_px, parts
 
     @property
     def confidence(self) -> dict:
