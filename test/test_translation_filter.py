@@ -214,12 +214,13 @@ def test_search_frame_finds_the_target_moved_anywhere_in_a_drone_frame(uav_root)
 
 def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, monkeypatch):
     """
-    Each strip's response is the filter's linear correlation over it, done directly.
+    Each strip's response is the cropped filter's linear correlation over it, done directly.
 
     building5's first 1280x720 frame at a scale with several strips (the first and last cut by
-    the frame's edges): the strip's features correlated with the spatial filter channel by channel
-    by ``scipy.signal.correlate`` (zero outside the strip), kept over the strip's own cells inside
-    the frame; the FFT's wrap may touch none of them.  ``search_frame`` is its peak.
+    the frame's edges): the strip's features correlated with the spatial filter cropped to the
+    target's cells, channel by channel, by ``scipy.signal.correlate`` (zero outside the strip),
+    kept over the strip's own cells inside the frame; the FFT's wrap may touch none of them.
+    The crop keeps nearly all the filter's energy.  ``search_frame`` is the response's peak.
     """
     from iemd_ros.datasets.otb import read_frame, load_sequence
     from scipy import fft as sfft, signal
@@ -233,17 +234,21 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     monkeypatch.setattr(features, 'extract', lambda *a: strips.append(extract(*a)) or strips[-1])
     parts = tf.frame_response(frame, size, 0)[3]
     assert parts >= 3
-    n, c0 = tf.map_hw[0], tf.map_hw[0] // 2
     h = sfft.irfft2(tf.f, s=tf.map_hw, axes=(1, 2))
+    crop = h[(slice(None),) + tf.target_cells]
+    assert (crop ** 2).sum() > 0.9 * (h ** 2).sum()  # 0.94 on this first frame
+    # the crop's cell answering for the target's centre (the full filter's centre cell)
+    oy, ox = (k // 2 - t.start for k, t in zip(tf.map_hw, tf.target_cells))
     for part in range(parts):
         strips.clear()
         resp, first, cell_px, _ = tf.frame_response(frame, size, part)
         z = strips[0]
-        lo = max(first - c0, 0)
-        direct = sum(signal.correlate(z[c], h[c], mode='full') for c in range(len(z)))
-        # full[p, q] is the shift (p - n + 1, q - n + 1); cell i answers at shift i - c0
+        lo = max(first - ox, 0)
+        direct = sum(signal.correlate(z[c], crop[c], mode='full') for c in range(len(z)))
+        # full[p, q] is the shift (p - m + 1, q - l + 1) for an m x l crop; cell i answers at i - oy
+        m, l_ = crop.shape[1:]
         rows, cols = resp.shape
-        kept = direct[n - 1 - c0:][:rows, n - 1 - c0 + first - lo:][:, :cols]
+        kept = direct[m - 1 - oy:][:rows, l_ - 1 - ox + first - lo:][:, :cols]
         assert kept.shape == resp.shape and rows * cell_px[1] == pytest.approx(frame.shape[0])
         np.testing.assert_allclose(resp, kept, rtol=0, atol=1e-5 * np.abs(kept).max())
         centre, value, _ = tf.search_frame(frame, size, part)

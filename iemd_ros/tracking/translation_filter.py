@@ -144,9 +144,11 @@ class TranslationFilter:
         self.yf_conj = np.conj(sfft.rfft2(gaussian_label(n, n, sigma))).astype(np.complex64)
         reg = np.full((n, n), REG_BACKGROUND)
         rw, rh = max(int(cells[0]), 1), max(int(cells[1]), 1)
-        ys = np.clip(np.arange(rh) - rh // 2 + n // 2, 0, n - 1)
-        xs = np.clip(np.arange(rw) - rw // 2 + n // 2, 0, n - 1)
-        reg[np.ix_(ys, xs)] = REG_TARGET
+        # the target's cells, where the filter may be nonzero (BACF's crop)
+        self.target_cells = tuple(
+            slice(max(n // 2 - k // 2, 0), min(n // 2 - k // 2 + k, n)) for k in (rh, rw)
+        )
+        reg[self.target_cells] = REG_TARGET
         self.reg_sq = (reg ** 2).astype(np.float32)
         self.peak = SubCellPeak(n, n)
         self.ky = (np.fft.fftfreq(n) * n).astype(np.float32)
@@ -272,10 +274,11 @@ class TranslationFilter:
         The filter's response over one vertical strip of ``frame``, at the scale of ``size``.
 
         The frame is resampled to the filter's scale and cut into vertical strips of at most
-        ``FRAME_SEARCH_CELLS`` feature cells.  The strip's features, read with a margin of half
-        the filter on each side, are correlated with the spatial filter so that the response is
-        linear, not circular, over the strip's own cells: zero-padded by the filter's size down
-        the frame, and across by the filter's size beyond the strip's own width (overlap-save: the
+        ``FRAME_SEARCH_CELLS`` feature cells.  The strip's features are correlated with the spatial
+        filter cropped to the target's cells (:attr:`target_cells`: the regularization leaves it
+        all but zero outside them, BACF's crop), read with the margins the crop needs, and
+        zero-padded so that the response is linear, not circular, over the strip's own cells:
+        by the crop's size down the frame and beyond the strip's own width (overlap-save: the
         margins wrap only into cells not returned).
 
         Parameters
@@ -310,10 +313,13 @@ class TranslationFilter:
         parts = max(int(np.ceil(cells[0] * cells[1] / FRAME_SEARCH_CELLS)), 1)
         width = int(np.ceil(cells[1] / parts))
         parts = int(np.ceil(cells[1] / width))  # no empty last strip
-        # a target at cell k answers at displacement k - c0
-        n, c0 = self.map_hw[0], self.map_hw[0] // 2
+        # the crop's size and where in it the target's centre is: a target at cell k answers
+        # at displacement k - centre
+        ty, tx = self.target_cells
+        crop = (ty.stop - ty.start, tx.stop - tx.start)
+        origin = (self.map_hw[0] // 2 - ty.start, self.map_hw[1] // 2 - tx.start)
         first = (part % parts) * width
-        lo, hi = max(first - c0, 0), min(first + width + c0, cells[1])
+        lo, hi = max(first - origin[1], 0), min(first + width + crop[1] - 1 - origin[1], cells[1])
         cell_px = np.array([cols / cells[1], rows / cells[0]])
         strip = sample_region(
             frame,
@@ -323,17 +329,18 @@ class TranslationFilter:
         )
         z = features.extract(strip, self.colour)
         # sizes the FFT factors well
-        shape = tuple(sfft.next_fast_len(k, real=True) for k in (cells[0] + n, width + n))
+        shape = tuple(
+            sfft.next_fast_len(k + c - 1, real=True) for k, c in zip((cells[0], width), crop)
+        )
         if (
             self._frame_filter is None
             or self._frame_filter[0] is not self.f
             or self._frame_filter[1] != shape
         ):
-            # the spatial filter, the target at the centre cell
-            h = sfft.irfft2(self.f, s=self.map_hw, axes=(1, 2))
+            h = sfft.irfft2(self.f, s=self.map_hw, axes=(1, 2))[(slice(None),) + self.target_cells]
             self._frame_filter = (self.f, shape, np.conj(sfft.rfft2(h, s=shape, axes=(1, 2))))
         resp_f = np.sum(self._frame_filter[2] * sfft.rfft2(z, s=shape, axes=(1, 2)), axis=0)
-        resp = np.roll(sfft.irfft2(resp_f, s=shape), (c0, c0), axis=(0, 1))[
+        resp = np.roll(sfft.irfft2(resp_f, s=shape), origin, axis=(0, 1))[
             :cells[0], first - lo:min(first + width, cells[1]) - lo
         ]
         return resp, first, cell_px, parts
