@@ -108,7 +108,8 @@ class TranslationFilter:
     def __init__(self):
         self.f = None
         self._detection = self._response = None
-        # (f, shape, its conjugate spectrum at that shape) for search_frame
+        # (f, shape, the conjugate spectrum of its crop to the target's cells at that shape) for
+        # frame_response
         self._frame_filter = None
         self.response_peak = None  # the last estimate's peak value
 
@@ -314,7 +315,7 @@ class TranslationFilter:
         width = int(np.ceil(cells[1] / parts))
         parts = int(np.ceil(cells[1] / width))  # no empty last strip
         # the crop's size and where in it the target's centre is: a target at cell k answers
-        # at displacement k - centre
+        # at displacement k - origin
         ty, tx = self.target_cells
         crop = (ty.stop - ty.start, tx.stop - tx.start)
         origin = (self.map_hw[0] // 2 - ty.start, self.map_hw[1] // 2 - tx.start)
