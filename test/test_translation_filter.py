@@ -245,7 +245,7 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
         z = strips[0]
         lo = max(first - ox, 0)
         direct = sum(signal.correlate(z[c], crop[c], mode='full') for c in range(len(z)))
-        # full[p, q] is the shift (p - m + 1, q - l + 1) for an m x l crop; cell i answers at i - oy
+        # full[p, q]: the shift (p - m + 1, q - l + 1) of an m x l crop; cell i answers at i - oy
         m, l_ = crop.shape[1:]
         rows, cols = resp.shape
         kept = direct[m - 1 - oy:][:rows, l_ - 1 - ox + first - lo:][:, :cols]
@@ -255,4 +255,4 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
         k = np.unravel_index(np.argmax(resp), resp.shape)
         assert value == resp[k]
         np.testing.assert_allclose(centre, (np.array([k[1] + first, k[0]]) + 0.5) * cell_px - 0.5)
-    assert first + cols == int(frame.shape[1] / cell_px[0] + 0.5)  # the last strip ends at the edge
+    assert first + cols == int(frame.shape[1] / cell_px[0] + 0.5)  # the last strip: to the edge
