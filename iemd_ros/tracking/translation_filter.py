@@ -272,7 +272,7 @@ class TranslationFilter:
         self, frame: np.ndarray, size, part: int = 0
     ) -> tuple[np.ndarray, int, np.ndarray, int]:
         """
-        Return the filter's response over one vertical strip of ``frame``, at the scale of ``size``.
+        Return the filter's response over one vertical strip of ``frame`` at the scale of ``size``.
 
         The frame is resampled to the filter's scale and cut into vertical strips of at most
         ``FRAME_SEARCH_CELLS`` feature cells.  The strip's features are correlated with the spatial
