@@ -112,7 +112,12 @@ def window_axes(angle: float) -> np.ndarray:
 
 
 def warp_window(
-    image: np.ndarray, centre, linear: np.ndarray, out_size, interpolation: int = cv2.INTER_LINEAR
+    image: np.ndarray,
+    centre,
+    linear: np.ndarray,
+    out_size,
+    interpolation: int = cv2.INTER_LINEAR,
+    origin=(0, 0),
 ):
     """
     Sample ``image`` on a grid of ``out_size`` pixels mapped affinely around ``centre``.
@@ -129,6 +134,9 @@ def warp_window(
         (Tw, Th), the sample's size.
     interpolation : int, optional
         OpenCV interpolation flag.
+    origin : array_like, optional
+        (x, y) whole pixels: where ``image``, a crop, starts in the image ``centre`` refers to
+        (its border must be the image's wherever the sample reaches past it).
 
     Returns
     -------
@@ -141,6 +149,7 @@ def warp_window(
     warp = np.column_stack(
         [linear, np.asarray(centre, dtype=np.float64) - linear @ [(tw - 1) / 2, (th - 1) / 2]]
     )
+    warp[:, 2] -= origin
     return cv2.warpAffine(
         image,
         warp,
@@ -158,10 +167,13 @@ class ImagePyramid:
     level ``floor(log2(s))``, where its scale is in [1, 2): every template pixel then integrates at
     least one pyrDown-smoothed pixel.  The levels are built on demand (:meth:`level`).
 
+    Uint8 grey levels are :func:`to_gray`'s levels in [0, 1], converted only where a window at
+    level 0 reads them until a level above needs the whole frame.
+
     Parameters
     ----------
     gray : ndarray
-        The frame's grey levels (level 0).
+        The frame's grey levels (level 0): HxW uint8, or float.
     max_levels : int, optional
         Most levels above the frame; a level is added only while the one below it has both sides of
         at least 32 pixels.
@@ -169,7 +181,9 @@ class ImagePyramid:
     """
 
     def __init__(self, gray: np.ndarray, max_levels: int = 4):
-        self._levels = [gray]  # built on demand by level(): most frames only need one or two
+        self._grey = gray if gray.dtype == np.uint8 else None
+        # built on demand by level(): most frames only need one or two
+        self._levels = [None if self._grey is not None else gray]
         h, w = gray.shape[:2]
         self.n_levels = 1
         while self.n_levels <= max_levels and min(h, w) >= 32:
@@ -191,9 +205,29 @@ class ImagePyramid:
             The level's image.
 
         """
+        if self._levels[0] is None:
+            self._levels[0] = to_gray(self._grey)
         while len(self._levels) <= index:
             self._levels.append(cv2.pyrDown(self._levels[-1]))
         return self._levels[index]
+
+    def _source(self, level: int, xs, ys) -> tuple[np.ndarray, tuple[int, int]]:
+        """
+        Return (image, its origin in level ``level``) that a sample reading ``xs``, ``ys`` needs.
+
+        At level 0 before the whole frame is converted, the crop of the frame around the points
+        (bilinear reads one pixel past them; the crop ends where the frame does, so its border is
+        the frame's wherever a read falls outside); else the level itself.
+        """
+        lo, hi = (np.array([np.min(xs), np.min(ys)]), np.array([np.max(xs), np.max(ys)]))
+        if level or self._levels[0] is not None or not np.all(np.isfinite([lo, hi])):
+            return self.level(level), (0, 0)
+        n = self._grey.shape[::-1]
+        x0, y0 = (min(max(int(np.floor(v)) - 1, 0), k - 1) for v, k in zip(lo, n))
+        x1, y1 = (
+            min(max(int(np.ceil(v)) + 2, start + 1), k) for v, start, k in zip(hi, (x0, y0), n)
+        )
+        return to_gray(self._grey[y0:y1, x0:x1]), (x0, y0)
 
     def sample(self, center, size, template_size, angle: float = 0.0) -> np.ndarray:
         """
@@ -218,7 +252,10 @@ class ImagePyramid:
 
         """
         level, linear, centre = self._geometry(center, size, template_size, angle)
-        return warp_window(self.level(level), centre, linear, template_size)
+        half = (np.asarray(template_size, dtype=np.float64) - 1) / 2
+        corners = centre[:, None] + linear @ ([[-1, 1, 1, -1], [-1, -1, 1, 1]] * half[:, None])
+        image, origin = self._source(level, corners[0], corners[1])
+        return warp_window(image, centre, linear, template_size, origin=origin)
 
     def sample_scales(
         self, center, size, template_size, factors, angle: float = 0.0
@@ -255,8 +292,11 @@ class ImagePyramid:
         factors = np.asarray(factors, dtype=np.float64)
         maps = centre[:, None, None, None] + factors[None, :, None, None] * offsets[:, None]
         maps = maps.reshape(2, -1, int(tw)).astype(np.float32)
+        image, origin = self._source(level, maps[0], maps[1])
+        if origin != (0, 0):  # whole pixels off float32 coordinates: exact
+            maps -= np.array(origin, dtype=np.float32)[:, None, None]
         out = cv2.remap(
-            self.level(level), maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
+            image, maps[0], maps[1], cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE
         )
         return out.reshape(len(factors), int(th), int(tw))
 

@@ -59,7 +59,6 @@ from iemd_ros.tracking.appearance import (
     grey_levels,
     ImagePyramid,
     PatchLayout,
-    to_gray,
     window_axes,
 )
 from iemd_ros.tracking.candidate import CandidateModel, SearchContext, TargetModel
@@ -677,7 +676,7 @@ class IemdTracker:
         reuse its buffer).
         """
         grey = grey_levels(frame, copy=self.config.flow_start)
-        return grey, ImagePyramid(to_gray(grey))
+        return grey, ImagePyramid(grey)
 
     def _confidence_check(self, center) -> tuple[float | None, str]:
         """
