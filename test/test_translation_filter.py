@@ -201,7 +201,7 @@ def test_search_frame_finds_the_target_moved_anywhere_in_a_drone_frame(uav_root)
     seq = load_sequence(uav_root / 'building5')
     frame, box = read_frame(seq.frame_paths[0]), np.asarray(seq.gt_boxes[0], float)
     tf = _learned(frame, box)
-    cell_px = features.CELL * tf._scale(box[2:])
+    cell_px = tf.cell_size(box[2:])
     for move in [(0.0, 0.0), (400.0, -150.0), (-300.0, -350.0)]:  # she is at (540, 555)
         moved = shifted(frame, *move)
         parts = tf.search_frame(moved, box[2:], 0)[2]

@@ -484,29 +484,36 @@ class IemdTracker:
         The filter searches where the target was lost (that place moved by the priors since), then,
         lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near where it
         happened), one strip of the whole frame (the frame is scanned over lost frames) refined by
-        a search at its peak.  Where no peak reaches ``found_response`` times the running mean, the
-        filter searches the place of the highest again at one other size of ``REDETECT_SIZES`` (a
-        target may come back nearer or farther); a window found so keeps the lost size unless its
-        EMD is lower at the other (the paper's scale rule, section 6.1).  The result when the best
-        peak reaches ``found_response`` times the running mean and its window's EMD is below the
-        lost limit, else None.  Nothing learns from the frame.
+        a search at its peak.  Where no peak reaches ``found_response`` times the running mean,
+        the highest, if more than a cell from the centre of the region it was found in, is
+        measured again in a region centred on it (the cosine window weakens a peak off the
+        centre); then, still short, the filter searches its place at one other size of
+        ``REDETECT_SIZES`` (a target may come back nearer or farther); a window found so keeps the
+        lost size unless its EMD is lower at the other (the paper's scale rule, section 6.1).  The
+        result when the best peak reaches ``found_response`` times the running mean and its
+        window's EMD is below the lost limit, else None.  Nothing learns from the frame.
         """
         tf, cfg = self._translation_filter, self.config
         # no frame learned yet: no response to compare a candidate with
         if tf is None or self._confidence is None:
             return None
         wanted = cfg.found_response * self._confidence
-        candidates = []  # (centre, filter peak there)
+        candidates = []  # (centre, filter peak there, where its region was centred)
         if _visible_fraction(self._anchor, size, angle, frame.shape) >= cfg.min_visible:
-            candidates.append(self._filter_peak(frame, self._anchor, size, angle))
+            at = self._anchor
+            candidates.append(self._filter_peak(frame, at, size, angle) + (at,))
         if self._lost_frames >= FRAME_SEARCH_AFTER and not (
             candidates and candidates[0][1] >= wanted
         ):
             coarse, _, parts = tf.search_frame(frame, size, self._search_part)
             self._search_part = (self._search_part + 1) % parts
-            candidates.append(self._filter_peak(frame, coarse, size, angle))
-        found, peak = max(candidates, key=lambda c: c[1], default=(None, -np.inf))
+            candidates.append(self._filter_peak(frame, coarse, size, angle) + (coarse,))
+        found, peak, at = max(candidates, key=lambda c: c[1], default=(None, -np.inf, None))
         other, searched = None, len(candidates)
+        # a peak off its region's centre is weakened by the cosine window: measured centred on it
+        if peak < wanted and candidates and np.hypot(*(found - at)) > tf.cell_size(size):
+            found, peak = self._filter_peak(frame, found, size, angle)
+            searched += 1
         factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
         if candidates and factor != 1.0:
             other = size * factor

@@ -444,6 +444,10 @@ class TranslationFilter:
         return f
 
     # ------------------------------------------------------------------ sampling
+    def cell_size(self, size) -> float:
+        """Return the image px of a feature cell for a window of ``size`` (w, h)."""
+        return features.CELL * self._scale(size)
+
     def _scale(self, size) -> float:
         """
         Image px per sample px for a window of ``size``.
