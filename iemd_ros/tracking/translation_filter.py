@@ -245,12 +245,8 @@ class TranslationFilter:
 
         Parameters
         ----------
-        frame : ndarray
-            The frame.
-        size : array_like
-            The window's size (w, h), px: the scale the frame is resampled to.
-        part : int
-            Which strip (taken modulo the number of strips).
+        frame, size, part
+            As in :meth:`frame_response`.
 
         Returns
         -------
