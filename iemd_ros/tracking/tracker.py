@@ -487,12 +487,11 @@ class IemdTracker:
         a search at its peak.  Where no peak reaches ``found_response`` times the running mean,
         the highest, if more than a cell from the centre of the region it was found in, is
         measured again in a region centred on it (the cosine window weakens a peak off the
-        centre), and the filter searches its place at one other size of ``REDETECT_SIZES`` too (a
-        target may come back nearer or farther), the higher peak of the two kept; a window found
-        so keeps the lost size unless its EMD is lower at the other (the paper's scale rule,
-        section 6.1).  The result when the best peak reaches ``found_response`` times the running
-        mean and its window's EMD is below the lost limit, else None.  Nothing learns from the
-        frame.
+        centre); then, still short, the filter searches its place at one other size of
+        ``REDETECT_SIZES`` (a target may come back nearer or farther); a window found so keeps the
+        lost size unless its EMD is lower at the other (the paper's scale rule, section 6.1).  The
+        result when the best peak reaches ``found_response`` times the running mean and its
+        window's EMD is below the lost limit, else None.  Nothing learns from the frame.
         """
         tf, cfg = self._translation_filter, self.config
         # no frame learned yet: no response to compare a candidate with
@@ -510,12 +509,12 @@ class IemdTracker:
             self._search_part = (self._search_part + 1) % parts
             candidates.append(self._filter_peak(frame, coarse, size, angle) + (coarse,))
         found, peak, at = max(candidates, key=lambda c: c[1], default=(None, -np.inf, None))
-        other, searched, short = None, len(candidates), peak < wanted
+        other, searched = None, len(candidates)
         # a peak off its region's centre is weakened by the cosine window: measured centred on it
-        if short and candidates and np.hypot(*(found - at)) > tf.cell_size(size):
+        if peak < wanted and candidates and np.hypot(*(found - at)) > tf.cell_size(size):
             found, peak = self._filter_peak(frame, found, size, angle)
             searched += 1
-        factor = _redetect_factor(self._lost_frames, size, frame.shape) if short else 1.0
+        factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
         if candidates and factor != 1.0:
             other = size * factor
             peaks = (
@@ -524,8 +523,7 @@ class IemdTracker:
                 else []
             )
             searched += len(peaks)
-            # the better of the two sizes there; the EMD chooses the size below
-            found, peak = max([(found, peak)] + peaks, key=lambda c: c[1])
+            found, peak = max(peaks, key=lambda c: c[1], default=(None, -np.inf))
         if peak < wanted:
             return None
         model = CandidateModel(self._context(pyramid, angle), found, size)
