@@ -211,17 +211,20 @@ class ImagePyramid:
             self._levels.append(cv2.pyrDown(self._levels[-1]))
         return self._levels[index]
 
-    def _source(self, level: int, xs, ys) -> tuple[np.ndarray, tuple[int, int]]:
-        """
-        Return (image, its origin in level ``level``) that a sample reading ``xs``, ``ys`` needs.
+    def _crops(self, level: int) -> bool:
+        """Whether a sample at ``level`` reads a crop: level 0, the whole frame not converted."""
+        return level == 0 and self._levels[0] is None
 
-        At level 0 before the whole frame is converted, the crop of the frame around the points
-        (bilinear reads one pixel past them; the crop ends where the frame does, so its border is
-        the frame's wherever a read falls outside); else the level itself.
+    def _crop(self, xs, ys) -> tuple[np.ndarray, tuple[int, int]]:
+        """
+        Return (level 0 around the points ``xs``, ``ys``, the crop's origin in it).
+
+        Bilinear reads one pixel past the points; the crop ends where the frame does, so its border
+        is the frame's wherever a read falls outside.  Non-finite points read the whole level.
         """
         lo, hi = (np.array([np.min(xs), np.min(ys)]), np.array([np.max(xs), np.max(ys)]))
-        if level or self._levels[0] is not None or not np.all(np.isfinite([lo, hi])):
-            return self.level(level), (0, 0)
+        if not np.all(np.isfinite([lo, hi])):
+            return self.level(0), (0, 0)
         n = self._grey.shape[::-1]
         x0, y0 = (min(max(int(np.floor(v)) - 1, 0), k - 1) for v, k in zip(lo, n))
         x1, y1 = (
@@ -252,9 +255,11 @@ class ImagePyramid:
 
         """
         level, linear, centre = self._geometry(center, size, template_size, angle)
+        if not self._crops(level):
+            return warp_window(self.level(level), centre, linear, template_size)
         half = (np.asarray(template_size, dtype=np.float64) - 1) / 2
         corners = centre[:, None] + linear @ ([[-1, 1, 1, -1], [-1, -1, 1, 1]] * half[:, None])
-        image, origin = self._source(level, corners[0], corners[1])
+        image, origin = self._crop(corners[0], corners[1])
         return warp_window(image, centre, linear, template_size, origin=origin)
 
     def sample_scales(
@@ -292,7 +297,7 @@ class ImagePyramid:
         factors = np.asarray(factors, dtype=np.float64)
         maps = centre[:, None, None, None] + factors[None, :, None, None] * offsets[:, None]
         maps = maps.reshape(2, -1, int(tw)).astype(np.float32)
-        image, origin = self._source(level, maps[0], maps[1])
+        image, origin = self._crop(*maps) if self._crops(level) else (self.level(level), (0, 0))
         if origin != (0, 0):  # whole pixels off float32 coordinates: exact
             maps -= np.array(origin, dtype=np.float32)[:, None, None]
         out = cv2.remap(

@@ -301,12 +301,9 @@ class TranslationFilter:
             How many strips the frame has at this scale.
 
         """
-        scale = self._scale(size)
         rows, cols = frame.shape[:2]
-        cells = (
-            max(int(rows / (features.CELL * scale)), 1),
-            max(int(cols / (features.CELL * scale)), 1),
-        )
+        cell = self.cell_size(size)
+        cells = (max(int(rows / cell), 1), max(int(cols / cell), 1))
         parts = max(int(np.ceil(cells[0] * cells[1] / FRAME_SEARCH_CELLS)), 1)
         width = int(np.ceil(cells[1] / parts))
         parts = int(np.ceil(cells[1] / width))  # no empty last strip
