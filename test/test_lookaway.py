@@ -215,6 +215,35 @@ def test_a_target_back_at_another_size_is_re_detected_at_that_size(
     assert long_term_scores(boxes, found, seq.gt_boxes).reacquired == 0
 
 
+def test_a_target_back_changed_is_taken_where_its_peak_stands_out_from_the_losss_background(
+    tmp_path, otb_root, monkeypatch
+):
+    """
+    Freeman1 cut to look away after 15 frames; he comes back nearer, his filter peak short.
+
+    From his return the filter's best candidate is on him at 0.75-0.97 times its running mean,
+    below ``found_response`` (1.0); the best peaks of the lost frames before his return
+    (background) are lower and steady, and his stands more than ``BACKGROUND_PEAK_STDS`` of their
+    deviations above them: he is re-detected within REACQUIRE_WITHIN frames, with that rule as
+    the reason.  With ``found_response`` alone he is not
+    (docs/decisions.md#redetection-background-level).
+    """
+    seq = load_sequence(
+        write_look_away(load_sequence(otb_root / 'Freeman1'), tmp_path / 'la', LookAway())
+    )
+    absent = np.isnan(seq.gt_boxes[:, 0])
+    boxes, found, results = _track_cut(seq)
+    scores = long_term_scores(boxes, found, seq.gt_boxes)
+    assert scores.returns == scores.reacquired == 1, scores
+    assert np.mean(found[absent]) <= 0.1
+    back = next(k for k, r in enumerate(results, start=1) if r.cause is Cause.REDETECTED)
+    assert not absent[back] and 'sd above the best peaks of' in results[back - 1].reason
+
+    monkeypatch.setattr(tracker_module, 'BACKGROUND_PEAKS_MIN', 10**9)
+    boxes, found, _ = _track_cut(seq)
+    assert long_term_scores(boxes, found, seq.gt_boxes).reacquired == 0
+
+
 def test_several_follow_lengths_give_one_cut_each_that_the_split_selects_by_source(
     tmp_path, capsys
 ):

@@ -41,9 +41,12 @@ from iemd_ros.tracking.analysis import descend, descent_tracker, search_context
 from iemd_ros.tracking.appearance import ImagePyramid, PatchLayout, to_gray
 from iemd_ros.tracking.template import TemplateDictionary
 from iemd_ros.tracking.tracker import (
+    _found_level,
     _redetect_factor,
     _scale_bounds,
     _visible_fraction,
+    BACKGROUND_PEAK_STDS,
+    BACKGROUND_PEAKS_MIN,
     Cause,
     CONFIDENT_APCE,
     CONFIDENT_PEAK,
@@ -672,6 +675,24 @@ def test_update_returns_before_the_models_learn_and_the_next_call_waits_for_them
     with pytest.raises(RuntimeError, match='learning failed'):
         tracker.wait_learned()
     tracker.wait_learned()  # raised once
+
+
+def test_the_found_level_falls_to_a_few_deviations_above_a_long_losss_background_peaks():
+    """
+    ``found_response`` x the running mean, until BACKGROUND_PEAKS_MIN lost frames' peaks are in.
+
+    Then BACKGROUND_PEAK_STDS standard deviations above their mean where that is lower, never
+    below ``lost_response`` x the running mean, never above the usual level.
+    """
+    assert (BACKGROUND_PEAKS_MIN, BACKGROUND_PEAK_STDS) == (20, 4.0)
+    steady = [0.04, 0.06] * 10  # mean 0.05, sd 0.01
+    level, how = _found_level(0.1, steady[:-1], 1.0, 0.5)
+    assert level == pytest.approx(0.1) and 'running mean' in how
+    level, how = _found_level(0.1, steady, 1.0, 0.5)
+    assert level == pytest.approx(0.05 + 4 * 0.01) and 'sd above the best peaks of 20' in how
+    assert _found_level(0.1, [0.02, 0.03] * 10, 1.0, 0.5)[0] == pytest.approx(0.05)  # the floor
+    assert _found_level(0.1, [0.04, 0.08] * 10, 1.0, 0.5)[0] == pytest.approx(0.1)  # no higher
+    assert _found_level(0.1, steady, 0.3, 0.5)[0] == pytest.approx(0.03)  # found below lost
 
 
 def test_re_detection_tries_each_other_size_in_turn_within_the_scale_bounds():

@@ -86,6 +86,11 @@ REDETECT_SIZES = (1.2**-2, 1.2**-1, 1.2, 1.2**2)
 # at least these fractions of their means over the frames that learned (its beta_1 and beta_2)
 CONFIDENT_PEAK = 0.7
 CONFIDENT_APCE = 0.45
+# a constant-false-alarm-rate level for re-detection (Finn and Johnson, RCA Review 1968): the best
+# peaks of this many lost frames measure the background, a peak this many of their standard
+# deviations above their mean stands out from it
+BACKGROUND_PEAKS_MIN = 20
+BACKGROUND_PEAK_STDS = 4.0
 
 
 class Cause(enum.Enum):
@@ -257,6 +262,8 @@ class IemdTracker:
         # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
         self._search_part = 0
         self._lost_frames = 0  # lost frames in a row
+        # lost: re-detection's best peak on each frame of this loss (the background's, while lost)
+        self._background_peaks = []
         # lost: where the target was lost, moved by the priors since (re-detection looks there)
         self._anchor = None
         self._prediction = None  # this frame's predicted centre
@@ -443,6 +450,7 @@ class IemdTracker:
         """
         if not self._lost:
             self._anchor = np.asarray(self._prediction, dtype=np.float64)
+            self._background_peaks = []
         self._center, self._size, self._angle, self._lost = center, size, angle, True
         self._lost_frames += 1
         return TrackResult(
@@ -490,14 +498,17 @@ class IemdTracker:
         centre); then, still short, the filter searches its place at one other size of
         ``REDETECT_SIZES`` (a target may come back nearer or farther); a window found so keeps the
         lost size unless its EMD is lower at the other (the paper's scale rule, section 6.1).  The
-        result when the best peak reaches ``found_response`` times the running mean and its
-        window's EMD is below the lost limit, else None.  Nothing learns from the frame.
+        result when the best peak reaches the level of :func:`_found_level` and its window's EMD
+        is below the lost limit, else None.  Nothing learns from the frame; its best peak at the
+        lost size joins the loss's background peaks.
         """
         tf, cfg = self._translation_filter, self.config
         # no frame learned yet: no response to compare a candidate with
         if tf is None or self._confidence is None:
             return None
-        wanted = cfg.found_response * self._confidence
+        wanted, level = _found_level(
+            self._confidence, self._background_peaks, cfg.found_response, cfg.lost_response
+        )
         candidates = []  # (centre, filter peak there, where its region was centred)
         if _visible_fraction(self._anchor, size, angle, frame.shape) >= cfg.min_visible:
             at = self._anchor
@@ -514,6 +525,8 @@ class IemdTracker:
         if peak < wanted and candidates and np.hypot(*(found - at)) > tf.cell_size(size):
             found, peak = self._filter_peak(frame, found, size, angle)
             searched += 1
+        if candidates:
+            self._background_peaks.append(peak)
         factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
         if candidates and factor != 1.0:
             other = size * factor
@@ -553,7 +566,7 @@ class IemdTracker:
             predicted_box=predicted,
             cause=Cause.REDETECTED,
             reason=(
-                f're-detected: filter peak {peak:.3f} >= {cfg.found_response} x its running mean'
+                f're-detected: filter peak {peak:.3f} >= {level}'
                 + (f', at {size[0]:.0f}x{size[1]:.0f} px (another size)' if resized else '')
             ),
         )
@@ -947,6 +960,43 @@ def _redetect_factor(lost_frames: int, size, shape) -> float:
     """
     factor = REDETECT_SIZES[lost_frames % len(REDETECT_SIZES)]
     return float(np.clip(factor, *_scale_bounds(size, shape)))
+
+
+def _found_level(confidence: float, background, found: float, lost: float) -> tuple[float, str]:
+    """
+    Return the filter peak a re-detection must reach, and how it was set.
+
+    Parameters
+    ----------
+    confidence : float
+        The running mean of the filter's response on learned frames.
+    background : sequence of float
+        Re-detection's best peak on each earlier frame of this loss.
+    found, lost : float
+        ``found_response`` and ``lost_response``.
+
+    Returns
+    -------
+    level : float
+        ``found`` times ``confidence``; from ``BACKGROUND_PEAKS_MIN`` background peaks on, no
+        higher than ``BACKGROUND_PEAK_STDS`` standard deviations above their mean (a target that
+        comes back changed stands out from the background the loss has seen, a constant false
+        alarm rate's level), and never below ``lost`` times ``confidence`` (a window that would
+        be lost at once is not taken).
+    how : str
+        The level and its rule, for the result's reason.
+
+    """
+    level = found * confidence
+    if len(background) >= BACKGROUND_PEAKS_MIN:
+        peaks = np.asarray(background, dtype=np.float64)
+        above = max(peaks.mean() + BACKGROUND_PEAK_STDS * peaks.std(), lost * confidence)
+        if above < level:
+            return above, (
+                f'{above:.3f}: {BACKGROUND_PEAK_STDS:g} sd above the best peaks of {len(peaks)} '
+                f'lost frames, at least {lost} x its running mean'
+            )
+    return level, f'{level:.3f} = {found} x its running mean'
 
 
 def _not_optimal(solution) -> int:
