@@ -684,15 +684,19 @@ def test_the_found_level_falls_to_a_few_deviations_above_a_long_losss_background
     Then BACKGROUND_PEAK_STDS standard deviations above their mean where that is lower, never
     below ``lost_response`` x the running mean, never above the usual level.
     """
+    def sums(peaks):
+        return np.array([len(peaks), sum(peaks), sum(p * p for p in peaks)])
+
     assert (BACKGROUND_PEAKS_MIN, BACKGROUND_PEAK_STDS) == (20, 4.0)
     steady = [0.04, 0.06] * 10  # mean 0.05, sd 0.01
-    level, how = _found_level(0.1, steady[:-1], 1.0, 0.5)
+    level, how = _found_level(0.1, sums(steady[:-1]), 1.0, 0.5)
     assert level == pytest.approx(0.1) and 'running mean' in how
-    level, how = _found_level(0.1, steady, 1.0, 0.5)
+    level, how = _found_level(0.1, sums(steady), 1.0, 0.5)
     assert level == pytest.approx(0.05 + 4 * 0.01) and 'sd above the best peaks of 20' in how
-    assert _found_level(0.1, [0.02, 0.03] * 10, 1.0, 0.5)[0] == pytest.approx(0.05)  # the floor
-    assert _found_level(0.1, [0.04, 0.08] * 10, 1.0, 0.5)[0] == pytest.approx(0.1)  # no higher
-    assert _found_level(0.1, steady, 0.3, 0.5)[0] == pytest.approx(0.03)  # found below lost
+    assert _found_level(0.1, sums([0.05] * 30), 1.0, 0.5)[0] == pytest.approx(0.05)  # sd 0
+    assert _found_level(0.1, sums([0.02, 0.03] * 10), 1.0, 0.5)[0] == pytest.approx(0.05)  # floor
+    assert _found_level(0.1, sums([0.04, 0.08] * 10), 1.0, 0.5)[0] == pytest.approx(0.1)
+    assert _found_level(0.1, sums(steady), 0.3, 0.5)[0] == pytest.approx(0.03)  # found < lost
 
 
 def test_re_detection_tries_each_other_size_in_turn_within_the_scale_bounds():

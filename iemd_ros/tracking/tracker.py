@@ -262,8 +262,8 @@ class IemdTracker:
         # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
         self._search_part = 0
         self._lost_frames = 0  # lost frames in a row
-        # lost: re-detection's best peak on each frame of this loss (the background's, while lost)
-        self._background_peaks = []
+        # lost: count, sum and sum of squares of re-detection's best peak on this loss's frames
+        self._background_peaks = np.zeros(3)
         # lost: where the target was lost, moved by the priors since (re-detection looks there)
         self._anchor = None
         self._prediction = None  # this frame's predicted centre
@@ -450,7 +450,7 @@ class IemdTracker:
         """
         if not self._lost:
             self._anchor = np.asarray(self._prediction, dtype=np.float64)
-            self._background_peaks = []
+            self._background_peaks = np.zeros(3)
         self._center, self._size, self._angle, self._lost = center, size, angle, True
         self._lost_frames += 1
         return TrackResult(
@@ -526,7 +526,7 @@ class IemdTracker:
             found, peak = self._filter_peak(frame, found, size, angle)
             searched += 1
         if candidates:
-            self._background_peaks.append(peak)
+            self._background_peaks += (1.0, peak, peak * peak)
         factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
         if candidates and factor != 1.0:
             other = size * factor
@@ -970,8 +970,9 @@ def _found_level(confidence: float, background, found: float, lost: float) -> tu
     ----------
     confidence : float
         The running mean of the filter's response on learned frames.
-    background : sequence of float
-        Re-detection's best peak on each earlier frame of this loss.
+    background : array_like
+        (count, sum, sum of squares) of re-detection's best peak on the earlier frames of this
+        loss.
     found, lost : float
         ``found_response`` and ``lost_response``.
 
@@ -988,12 +989,14 @@ def _found_level(confidence: float, background, found: float, lost: float) -> tu
 
     """
     level = found * confidence
-    if len(background) >= BACKGROUND_PEAKS_MIN:
-        peaks = np.asarray(background, dtype=np.float64)
-        above = max(peaks.mean() + BACKGROUND_PEAK_STDS * peaks.std(), lost * confidence)
+    n, total, squares = background
+    if n >= BACKGROUND_PEAKS_MIN:
+        mean = total / n
+        sd = np.sqrt(max(squares / n - mean * mean, 0.0))
+        above = max(mean + BACKGROUND_PEAK_STDS * sd, lost * confidence)
         if above < level:
             return above, (
-                f'{above:.3f}: {BACKGROUND_PEAK_STDS:g} sd above the best peaks of {len(peaks)} '
+                f'{above:.3f}: {BACKGROUND_PEAK_STDS:g} sd above the best peaks of {n:.0f} '
                 f'lost frames, at least {lost} x its running mean'
             )
     return level, f'{level:.3f} = {found} x its running mean'
