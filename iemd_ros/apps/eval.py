@@ -162,6 +162,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     def body() -> int:
         args = build_parser().parse_args(argv)
+        workers = Workers.from_args(args)  # an argument's error before any data is read
         trackers = list(dict.fromkeys(args.trackers))
         for t in trackers:
             make_tracker(t)  # fail early on an unknown tracker or one this OpenCV build lacks
@@ -188,7 +189,6 @@ def main(argv: list[str] | None = None) -> int:
                 raise ValueError(f"the inputs hold none of the {args.split} part's sequences")
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
-        workers = Workers.from_args(args)
         n_jobs = len(trackers) * len(sequences)
         t_start = time.perf_counter()
         print(
