@@ -39,7 +39,7 @@ of a 0-based box ``(x, y, w, h)``, :mod:`iemd_ros.common.boxes`); a size is ``(w
 from __future__ import annotations
 
 import cv2
-from iemd_ros.tracking.appearance import window_axes
+from iemd_ros.tracking.appearance import warp_window, window_axes
 import numba
 import numpy as np
 
@@ -90,11 +90,8 @@ def sample_region(img: np.ndarray, centre, region_wh, out_wh, angle: float = 0.0
         if min(src.shape[:2]) < 4:
             break
         src, f = cv2.pyrDown(src), f * 2.0
-    linear = window_axes(angle) * [sx / f, sy / f]
-    c = (np.asarray(centre, dtype=np.float64) + 0.5) / f - 0.5
-    warp = np.column_stack([linear, c - linear @ [(ow - 1) / 2, (oh - 1) / 2]])
-    return cv2.warpAffine(src, warp, (ow, oh), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-                          borderMode=cv2.BORDER_REPLICATE)
+    centre_at_level = (np.asarray(centre, dtype=np.float64) + 0.5) / f - 0.5
+    return warp_window(src, centre_at_level, window_axes(angle) * [sx / f, sy / f], (ow, oh))
 
 
 def _axis_aligned(img, centre, region_wh, ow: int, oh: int) -> np.ndarray:
