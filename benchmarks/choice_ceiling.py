@@ -40,13 +40,16 @@ Every sequence of ``../shared`` (OTB and drone) is tracked from the ground truth
 * ``start``: on every annotated frame the search is handed only the start (the prediction, the
   flow's, the filter's or the colour model's window) whose centre is nearest the true centre; the
   rest (the occlusion check, the scale, learning, the lost state) is the tracker's own;
-* ``scale``: the scale filter's estimate replaced by the true size over the window's size;
-* ``both``: the two together.
+* ``scale``: the scale filter's estimate replaced by the true size over the window's size (the
+  area; the window keeps its aspect ratio);
+* ``aspect``: the window's aspect ratio set to the true one after the scale filter, its area the
+  tracker's own;
+* ``both``: ``start`` and ``scale`` together.
 
 Printed: the average overlap per sequence and the mean, per variant.  The gap between ``tracker``
 and ``start`` is what a better choice among the starts the tracker already has could win, with
-nothing new to find the target; ``scale`` is the same for the size
-(docs/decisions.md#choice-ceiling).
+nothing new to find the target; ``scale`` and ``aspect`` are the same for the size
+(docs/decisions.md#choice-ceiling, docs/decisions.md#aspect-ratio).
 """
 import argparse
 from multiprocessing import Pool
@@ -59,15 +62,16 @@ from iemd_ros.evaluation.split import in_part, PARTS, split_names
 from iemd_ros.tracking.tracker import IemdTracker
 import numpy as np
 
-VARIANTS = ('tracker', 'start', 'scale', 'both')
+VARIANTS = ('tracker', 'start', 'scale', 'aspect', 'both')
 
 
 class OracleTracker(IemdTracker):
-    """The shipped tracker, its start choice and / or its scale taken from the ground truth."""
+    """The shipped tracker, its start choice, scale or aspect taken from the ground truth."""
 
-    def __init__(self, gt: np.ndarray, start: bool, scale: bool):
+    def __init__(self, gt: np.ndarray, start: bool, scale: bool, aspect: bool = False):
         super().__init__()
         self._gt, self._oracle_start, self._oracle_scale = gt, start, scale
+        self._oracle_aspect = aspect
 
     def _truth(self):
         """Return the ground-truth box of the frame being tracked, or None where it is absent."""
@@ -86,15 +90,20 @@ class OracleTracker(IemdTracker):
         truth = self._truth()
         if self._oracle_scale and truth is not None:
             scale = float(np.sqrt(truth[2] * truth[3] / np.prod(best.model.size)))
+        if self._oracle_aspect and truth is not None:
+            # the same area at the true width / height (a scale per axis)
+            area = float(np.prod(best.model.size)) * scale ** 2
+            ratio = truth[2] / truth[3]
+            scale = np.sqrt([area * ratio, area / ratio]) / best.model.size
         return found, scale
 
 
 class OracleAdapter(IemdAdapter):
     """:class:`OracleTracker` in `iemd-eval`'s one-pass run and scoring."""
 
-    def __init__(self, gt: np.ndarray, start: bool, scale: bool):
+    def __init__(self, gt: np.ndarray, start: bool, scale: bool, aspect: bool = False):
         super().__init__()
-        self._tracker = OracleTracker(gt, start, scale)
+        self._tracker = OracleTracker(gt, start, scale, aspect)
 
 
 def run(job) -> tuple[str, str, float]:
@@ -103,7 +112,7 @@ def run(job) -> tuple[str, str, float]:
     seq = load_sequence(name)
     oracle = OracleAdapter(
         np.asarray(seq.gt_boxes, dtype=float), variant in ('start', 'both'),
-        variant in ('scale', 'both'),
+        variant in ('scale', 'both'), variant == 'aspect',
     )
     return name, variant, evaluate_sequence(seq, oracle)[0].average_overlap
 
