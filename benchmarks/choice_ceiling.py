@@ -91,7 +91,8 @@ class OracleTracker(IemdTracker):
         if self._oracle_scale and truth is not None:
             scale = float(np.sqrt(truth[2] * truth[3] / np.prod(best.model.size)))
         if self._oracle_aspect and truth is not None:
-            # the same area at the true width / height (a scale per axis)
+            # the same area at the true width / height: a scale per axis (TrackResult.scale then
+            # holds the pair; the evaluation reads only the box)
             area = float(np.prod(best.model.size)) * scale ** 2
             ratio = truth[2] / truth[3]
             scale = np.sqrt([area * ratio, area / ratio]) / best.model.size
