@@ -62,16 +62,22 @@ from iemd_ros.evaluation.split import in_part, PARTS, split_names
 from iemd_ros.tracking.tracker import IemdTracker
 import numpy as np
 
-VARIANTS = ('tracker', 'start', 'scale', 'aspect', 'both')
+# each variant and what the ground truth decides in it
+VARIANTS = {
+    'tracker': frozenset(),
+    'start': frozenset({'start'}),
+    'scale': frozenset({'scale'}),
+    'aspect': frozenset({'aspect'}),
+    'both': frozenset({'start', 'scale'}),
+}
 
 
 class OracleTracker(IemdTracker):
     """The shipped tracker, its start choice, scale or aspect taken from the ground truth."""
 
-    def __init__(self, gt: np.ndarray, start: bool, scale: bool, aspect: bool = False):
+    def __init__(self, gt: np.ndarray, oracles: frozenset):
         super().__init__()
-        self._gt, self._oracle_start, self._oracle_scale = gt, start, scale
-        self._oracle_aspect = aspect
+        self._gt, self._oracles = gt, oracles
 
     def _truth(self):
         """Return the ground-truth box of the frame being tracked, or None where it is absent."""
@@ -80,7 +86,7 @@ class OracleTracker(IemdTracker):
 
     def _search(self, models, prediction):
         truth = self._truth()
-        if self._oracle_start and truth is not None:
+        if 'start' in self._oracles and truth is not None:
             centre = box_centre(truth)
             models = [min(models, key=lambda m: float(np.linalg.norm(m.center - centre)))]
         return super()._search(models, prediction)
@@ -88,9 +94,9 @@ class OracleTracker(IemdTracker):
     def _estimate_scale(self, frame, best, bounds):
         found, scale = super()._estimate_scale(frame, best, bounds)
         truth = self._truth()
-        if self._oracle_scale and truth is not None:
+        if 'scale' in self._oracles and truth is not None:
             scale = float(np.sqrt(truth[2] * truth[3] / np.prod(best.model.size)))
-        if self._oracle_aspect and truth is not None:
+        if 'aspect' in self._oracles and truth is not None:
             # the same area at the true width / height: a scale per axis (TrackResult.scale then
             # holds the pair; the evaluation reads only the box)
             area = float(np.prod(best.model.size)) * scale ** 2
@@ -102,19 +108,16 @@ class OracleTracker(IemdTracker):
 class OracleAdapter(IemdAdapter):
     """:class:`OracleTracker` in `iemd-eval`'s one-pass run and scoring."""
 
-    def __init__(self, gt: np.ndarray, start: bool, scale: bool, aspect: bool = False):
+    def __init__(self, gt: np.ndarray, oracles: frozenset):
         super().__init__()
-        self._tracker = OracleTracker(gt, start, scale, aspect)
+        self._tracker = OracleTracker(gt, oracles)
 
 
 def run(job) -> tuple[str, str, float]:
     """Return (sequence, variant, average overlap) of one run from the ground truth."""
     name, variant = job
     seq = load_sequence(name)
-    oracle = OracleAdapter(
-        np.asarray(seq.gt_boxes, dtype=float), variant in ('start', 'both'),
-        variant in ('scale', 'both'), variant == 'aspect',
-    )
+    oracle = OracleAdapter(np.asarray(seq.gt_boxes, dtype=float), VARIANTS[variant])
     return name, variant, evaluate_sequence(seq, oracle)[0].average_overlap
 
 
