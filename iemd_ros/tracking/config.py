@@ -245,9 +245,9 @@ class TrackerConfig:
     )
     found_response: float = param(
         1.0,
-        "while lost, a re-detected window is taken when the filter's peak there "
-        'reaches this times its running mean (after a long loss, or stands out from '
-        "the loss's own best peaks)",
+        "while lost, the window is found again when the filter's peak there reaches "
+        'this times its running mean (after a long loss re-detection also takes a peak '
+        "that stands out from the loss's own best peaks)",
         range=(0.01, 10.0),
         decision='re-detection',
     )
