@@ -77,7 +77,7 @@ import scipy.fft as sfft
 __all__ = ['Region', 'TranslationFilter', 'SEARCH_AREA_SCALE']
 
 SEARCH_AREA_SCALE = 5.0                       # side of the search region / sqrt(w h) (STRCF, BACF)
-SAMPLE_AREA = (150.0 ** 2, 160.0 ** 2)        # resampled area, px^2 (docs/decisions.md#sample-area)
+SAMPLE_AREA = (150.0 ** 2, 160.0 ** 2)        # resampled px^2 (docs/decisions.md#sample-area)
 OUTPUT_SIGMA_FACTOR = 1.0 / 16                # label std / sqrt(w h) in cells (STRCF)
 REG_TARGET, REG_BACKGROUND = 1e-3, 1e5        # BACF's binary spatial regularization
 MU = 15.0                                     # STRCF's temporal regularization
