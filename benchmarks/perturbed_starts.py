@@ -47,7 +47,8 @@ and starts, its mean per start, per sequence, and the median update time.  ``--c
 with other TrackerConfig values (default: the defaults), each against the same peers.
 
 A difference between two trackers is printed run by run (``paired_difference``: the mean difference
-in points, its 95 % interval with whole sequences resampled, the runs better, worse and equal):
+in points, its 95 % interval with whole sequences resampled, the runs better, worse and equal; then
+the mean difference per sequence):
 every configuration after the first against the first, and, with ``--against FILE``, every tracker
 of this run against the first of a run saved by ``--save FILE`` (the same starts and shift; another
 source tree, say).  A saved run records the digest of the ``iemd_ros.tracking`` sources it ran and
@@ -214,13 +215,14 @@ def main() -> None:
             )
         print('    ' + ' '.join(f'{n}={v:.1f}' for n, v in zip(names, overlap.mean(axis=1))))
         if i > 0 and runs[i][1] == 'iemd':
-            _print_difference(overlap, overlaps[first], first)
+            _print_difference(overlap, overlaps[first], first, names)
         if reference is not None:
             ref_label, ref_overlap, ref_source = reference
             _print_difference(
                 overlap,
                 ref_overlap,
                 f'{ref_label} ({args.against}: {ref_source}; this run: tracker sources {digest})',
+                names,
             )
     if args.save is not None:
         args.save.write_text(
@@ -240,12 +242,14 @@ def main() -> None:
         )
 
 
-def _print_difference(ours: np.ndarray, reference: np.ndarray, label: str) -> None:
+def _print_difference(ours: np.ndarray, reference: np.ndarray, label: str, names) -> None:
     d = paired_difference(ours, reference)
     print(
         f'    against {label}: {d.mean:+.1f} points, 95 % interval over sequences {d.low:+.1f} .. '
         f'{d.high:+.1f}; runs better / worse / equal {d.better} / {d.worse} / {d.equal}'
     )
+    by_sequence = (ours - reference).mean(axis=1)
+    print('      by sequence: ' + ' '.join(f'{n} {v:+.1f}' for n, v in zip(names, by_sequence)))
 
 
 def _tracker_digest() -> str:
