@@ -242,14 +242,15 @@ def main() -> None:
         )
 
 
-def _print_difference(ours: np.ndarray, reference: np.ndarray, label: str, names) -> None:
+def _print_difference(
+    ours: np.ndarray, reference: np.ndarray, label: str, names: list[str]
+) -> None:
     d = paired_difference(ours, reference)
     print(
         f'    against {label}: {d.mean:+.1f} points, 95 % interval over sequences {d.low:+.1f} .. '
         f'{d.high:+.1f}; runs better / worse / equal {d.better} / {d.worse} / {d.equal}'
     )
-    by_sequence = (ours - reference).mean(axis=1)
-    print('      by sequence: ' + ' '.join(f'{n} {v:+.1f}' for n, v in zip(names, by_sequence)))
+    print('      by sequence: ' + ' '.join(f'{n} {v:+.1f}' for n, v in zip(names, d.per_sequence)))
 
 
 def _tracker_digest() -> str:

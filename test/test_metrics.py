@@ -184,6 +184,12 @@ def test_a_gain_on_every_run_has_a_tight_interval_and_one_sequence_alone_does_no
     assert (ties.mean, ties.equal) == (0.0, 50)
 
 
+def test_a_paired_difference_gives_each_sequence_its_own_mean():
+    reference = np.zeros((3, 4))
+    ours = np.array([[1.0, 3.0, 1.0, 3.0], [0.0, 0.0, 0.0, -4.0], [0.0, 0.0, 0.0, 0.0]])
+    assert paired_difference(ours, reference).per_sequence == pytest.approx((2.0, -1.0, 0.0))
+
+
 @pytest.mark.parametrize(
     'ours, reference, kwargs, message',
     [

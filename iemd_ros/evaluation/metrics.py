@@ -519,6 +519,7 @@ class PairedDifference:
     better: int  # runs where ours is higher
     worse: int  # runs where ours is lower
     equal: int  # runs with the same value
+    per_sequence: tuple[float, ...]  # mean difference of each sequence's runs, in input order
 
 
 def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) -> PairedDifference:
@@ -542,7 +543,8 @@ def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) ->
     Returns
     -------
     PairedDifference
-        The mean difference, its 95 % interval and the runs better, worse and equal.
+        The mean difference, its 95 % interval, the runs better, worse and equal, and the mean
+        difference per sequence.
 
     Raises
     ------
@@ -574,4 +576,5 @@ def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) ->
         better=int((diff > 0).sum()),
         worse=int((diff < 0).sum()),
         equal=int((diff == 0).sum()),
+        per_sequence=tuple(float(v) for v in per_sequence),
     )
