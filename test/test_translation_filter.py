@@ -47,7 +47,8 @@ def _learned(frame, box, angle=0.0):
         frame,
         box_centre(box),
         box[2:],
-        colour=frame.ndim == 3 and frame[..., 0].std() > 0,
+        # the tracker's rule: colour unless the three channels are equal
+        colour=frame.ndim == 3 and not (frame == frame[..., :1]).all(),
         angle=angle,
     )
     return translation_filter
@@ -77,6 +78,39 @@ def test_recovers_a_known_shift_of_a_real_texture(car4_first, angle):
         estimate = tf.estimate(tf.sample(shifted(frame, *move), centre, size, angle))
         assert np.linalg.norm(estimate - move) < cell_px / 4, (move, estimate, cell_px)
     assert tf.confidence['peak'] > 0 and tf.confidence['apce'] > 1
+
+
+@pytest.mark.parametrize('colour', [True, False])
+def test_the_sample_weighs_colour_names_against_fhog_and_grey(colour):
+    """
+    The region's features are grey, fHOG and Colour Names times the cosine window.
+
+    A smooth random colour texture (and its grey version): the inverse transform of the sample's
+    spectrum is ``features.extract`` of the resampled region times the separable Hann window, its
+    Colour Names channels times ``CN_WEIGHT``, the other channels times 1; a grey frame has no
+    Colour Names channel.
+    """
+    from iemd_ros.tracking.correlation_filter import hann_inner, sample_region
+    from iemd_ros.tracking.translation_filter import CN_WEIGHT
+    from scipy import fft as sfft
+    import cv2
+
+    rng = np.random.default_rng(3)
+    frame = cv2.GaussianBlur(rng.integers(0, 256, (240, 320, 3), dtype=np.uint8), (0, 0), 3)
+    if not colour:
+        frame = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+    centre, size = np.array([161.0, 118.0]), np.array([40.0, 30.0])
+    tf = TranslationFilter()
+    tf.init(frame, centre, size, colour=colour)
+    region = tf.sample(frame, centre, size)
+    side = tf.support * region.scale
+    patch = sample_region(frame, region.pos, (side, side), (tf.support, tf.support))
+    expected = features.extract(patch, colour)
+    assert len(expected) == (42 if colour else 32)
+    expected *= (hann_inner(tf.map_hw[0])[:, None] * hann_inner(tf.map_hw[1])[None, :])[None]
+    expected[features.CN_START:] *= CN_WEIGHT
+    got = sfft.irfft2(region.zf, s=tf.map_hw)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-5 * np.abs(expected).max())
 
 
 def test_response_at_reads_the_map_between_cells(car4_first):
@@ -217,8 +251,9 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     Each strip's response is the cropped filter's linear correlation over it, done directly.
 
     building5's first 1280x720 frame at a scale with several strips (the first and last cut by
-    the frame's edges): the strip's features correlated with the spatial filter cropped to the
-    target's cells, channel by channel, by ``scipy.signal.correlate`` (zero outside the strip),
+    the frame's edges): the strip's features, each channel times the filter's channel weight,
+    correlated with the spatial filter cropped to the target's cells, channel by channel, by
+    ``scipy.signal.correlate`` (zero outside the strip),
     kept over the strip's own cells inside the frame; the FFT's wrap may touch none of them.
     The crop keeps nearly all the filter's energy.  ``search_frame`` is the response's peak.
     """
@@ -231,7 +266,10 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     size = box[2:] * 0.5  # the frame at a larger scale: more strips
     strips = []
     extract = features.extract
-    monkeypatch.setattr(features, 'extract', lambda *a: strips.append(extract(*a)) or strips[-1])
+    # the features as extracted (frame_response weighs its own copy)
+    monkeypatch.setattr(
+        features, 'extract', lambda *a: strips.append(extract(*a)) or strips[-1].copy()
+    )
     parts = tf.frame_response(frame, size, 0)[3]
     assert parts >= 3
     h = sfft.irfft2(tf.f, s=tf.map_hw, axes=(1, 2))
@@ -242,7 +280,7 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     for part in range(parts):
         strips.clear()
         resp, first, cell_px, _ = tf.frame_response(frame, size, part)
-        z = strips[0]
+        z = strips[0] * tf.channel_weight[:, None, None]
         lo = max(first - ox, 0)
         direct = sum(signal.correlate(z[c], crop[c], mode='full') for c in range(len(z)))
         # full[p, q]: the shift (p - m + 1, q - l + 1) of an m x l crop; cell i answers at i - oy

@@ -58,10 +58,14 @@ from pathlib import Path
 import numba
 import numpy as np
 
-__all__ = ['N_HOG', 'N_CN', 'CELL', 'colour_names', 'fhog', 'fhog_batch', 'n_channels', 'extract']
+__all__ = [
+    'N_HOG', 'N_CN', 'CN_START', 'CELL',
+    'colour_names', 'fhog', 'fhog_batch', 'n_channels', 'extract',
+]
 
 N_HOG = 31
 N_CN = 10
+CN_START = 1 + N_HOG  # the first Colour Names channel of extract()'s map (grey, fHOG, CN)
 CELL = 4  # pixels per cell side
 
 
@@ -365,7 +369,7 @@ def extract(
     shape = (n_channels(colour), a.shape[0] // cell, a.shape[1] // cell)
     if out is None:
         out = np.empty(shape, np.float32)
-    _colour_into(a, cell, colour_names(), colour, out, 0, 1 + N_HOG)
+    _colour_into(a, cell, colour_names(), colour, out, 0, CN_START)
     _fhog_into(a, cell, np.float32(0.2), out, 1)
     return out
 

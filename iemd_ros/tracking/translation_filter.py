@@ -38,7 +38,8 @@ target's.  A correlation filter trained on the target against its own surroundin
 complementary view (docs/decisions.md#strcf).
 
 * Features (:mod:`iemd_ros.tracking.features`): grey + fHOG + Colour Names on 4x4 cells (42
-  channels; 32 on grey frames), the feature set of STRCF and AutoTrack.
+  channels; 32 on grey frames), the feature set of STRCF and AutoTrack; the Colour Names weighted
+  by ``CN_WEIGHT`` against fHOG and grey (docs/decisions.md#colour-names-weight).
 * Sample: a square region of side ``SEARCH_AREA_SCALE`` x ``sqrt(w h)`` of the target, turned with
   the window, resampled so that its area lies in ``[150^2, 160^2]`` px (at most 40 x 40 cells); a
   cosine window; a Gaussian label of std ``sqrt(w h) / cell / 16`` cells.
@@ -77,6 +78,7 @@ import scipy.fft as sfft
 __all__ = ['Region', 'TranslationFilter', 'SEARCH_AREA_SCALE']
 
 SEARCH_AREA_SCALE = 5.0                       # side of the search region / sqrt(w h) (STRCF, BACF)
+CN_WEIGHT = 2.0                               # Colour Names' factor, fHOG's and grey's 1
 SAMPLE_AREA = (150.0 ** 2, 160.0 ** 2)        # resampled px^2 (docs/decisions.md#sample-area)
 OUTPUT_SIGMA_FACTOR = 1.0 / 16                # label std / sqrt(w h) in cells (STRCF)
 REG_TARGET, REG_BACKGROUND = 1e-3, 1e5        # BACF's binary spatial regularization
@@ -139,7 +141,12 @@ class TranslationFilter:
         self.map_hw = (n, n)
         self.support = float(n * features.CELL)            # the resampled sample's side, px
         self.T = n * n
-        self.window = (hann_inner(n)[:, None] * hann_inner(n)[None, :]).astype(np.float32)
+        # each feature channel's weight, and the cosine window times it
+        self.channel_weight = np.ones(features.n_channels(self.colour), np.float32)
+        self.channel_weight[features.CN_START:] = CN_WEIGHT
+        self.window = (
+            self.channel_weight[:, None, None] * (hann_inner(n)[:, None] * hann_inner(n)[None, :])
+        ).astype(np.float32)
         cells = np.floor(self.base_wh / features.CELL)
         sigma = max(float(np.sqrt(np.prod(cells))) * OUTPUT_SIGMA_FACTOR, 1e-3)
         self.yf_conj = np.conj(sfft.rfft2(gaussian_label(n, n, sigma))).astype(np.complex64)
@@ -322,6 +329,7 @@ class TranslationFilter:
             ((hi - lo) * features.CELL, cells[0] * features.CELL),
         )
         z = features.extract(strip, self.colour)
+        z *= self.channel_weight[:, None, None]
         # sizes the FFT factors well
         shape = tuple(
             sfft.next_fast_len(k + c - 1, real=True) for k, c in zip((cells[0], width), crop)
@@ -465,7 +473,7 @@ class TranslationFilter:
         side = self.support * scale
         patch = sample_region(frame, pos, (side, side), (self.support, self.support), angle)
         x = features.extract(patch, self.colour)
-        x *= self.window[None]
+        x *= self.window
         return sfft.rfft2(x).astype(np.complex64, copy=False)
 
 
