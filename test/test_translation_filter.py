@@ -251,13 +251,14 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     Each strip's response is the cropped filter's linear correlation over it, done directly.
 
     building5's first 1280x720 frame at a scale with several strips (the first and last cut by
-    the frame's edges): the strip's features, each channel times the filter's channel weight,
-    correlated with the spatial filter cropped to the target's cells, channel by channel, by
-    ``scipy.signal.correlate`` (zero outside the strip),
-    kept over the strip's own cells inside the frame; the FFT's wrap may touch none of them.
-    The crop keeps nearly all the filter's energy.  ``search_frame`` is the response's peak.
+    the frame's edges): the strip's features, the Colour Names times ``CN_WEIGHT``, correlated
+    with the spatial filter cropped to the target's cells, channel by channel, by
+    ``scipy.signal.correlate`` (zero outside the strip), kept over the strip's own cells inside the
+    frame; the FFT's wrap may touch none of them.  The crop keeps nearly all the filter's energy.
+    ``search_frame`` is the response's peak.
     """
     from iemd_ros.datasets.otb import read_frame, load_sequence
+    from iemd_ros.tracking.translation_filter import CN_WEIGHT
     from scipy import fft as sfft, signal
 
     seq = load_sequence(uav_root / 'building5')
@@ -280,7 +281,8 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     for part in range(parts):
         strips.clear()
         resp, first, cell_px, _ = tf.frame_response(frame, size, part)
-        z = strips[0] * tf.channel_weight[:, None, None]
+        z = strips[0]
+        z[features.CN_START:] *= CN_WEIGHT
         lo = max(first - ox, 0)
         direct = sum(signal.correlate(z[c], crop[c], mode='full') for c in range(len(z)))
         # full[p, q]: the shift (p - m + 1, q - l + 1) of an m x l crop; cell i answers at i - oy

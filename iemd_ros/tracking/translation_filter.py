@@ -78,7 +78,7 @@ import scipy.fft as sfft
 __all__ = ['Region', 'TranslationFilter', 'SEARCH_AREA_SCALE']
 
 SEARCH_AREA_SCALE = 5.0                       # side of the search region / sqrt(w h) (STRCF, BACF)
-CN_WEIGHT = 2.0                               # Colour Names' factor, fHOG's and grey's 1
+CN_WEIGHT = 2.0                               # Colour Names channels' weight; fHOG's, grey's 1
 SAMPLE_AREA = (150.0 ** 2, 160.0 ** 2)        # resampled px^2 (docs/decisions.md#sample-area)
 OUTPUT_SIGMA_FACTOR = 1.0 / 16                # label std / sqrt(w h) in cells (STRCF)
 REG_TARGET, REG_BACKGROUND = 1e-3, 1e5        # BACF's binary spatial regularization
