@@ -36,6 +36,7 @@ from helpers import shifted
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking import features
+from iemd_ros.tracking.tracker import _is_colour
 from iemd_ros.tracking.translation_filter import TranslationFilter
 import numpy as np
 import pytest
@@ -47,8 +48,7 @@ def _learned(frame, box, angle=0.0):
         frame,
         box_centre(box),
         box[2:],
-        # the tracker's rule: colour unless the three channels are equal
-        colour=frame.ndim == 3 and not (frame == frame[..., :1]).all(),
+        colour=_is_colour(frame),  # the tracker's own rule
         angle=angle,
     )
     return translation_filter

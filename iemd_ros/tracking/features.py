@@ -333,7 +333,7 @@ def _colour_into(bgr, cell, table, use_cn, out, grey_ch, cn_off):
 
 def n_channels(colour: bool) -> int:
     """Return how many channels :func:`extract` returns: 42 on colour frames, 32 on grey ones."""
-    return 1 + N_HOG + (N_CN if colour else 0)
+    return CN_START + (N_CN if colour else 0)
 
 
 def extract(
