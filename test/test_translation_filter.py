@@ -37,7 +37,7 @@ from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking import features
 from iemd_ros.tracking.tracker import _is_colour
-from iemd_ros.tracking.translation_filter import TranslationFilter
+from iemd_ros.tracking.translation_filter import CN_WEIGHT, TranslationFilter
 import numpy as np
 import pytest
 
@@ -91,7 +91,6 @@ def test_the_sample_weighs_colour_names_against_fhog_and_grey(colour):
     Colour Names channel.
     """
     from iemd_ros.tracking.correlation_filter import hann_inner, sample_region
-    from iemd_ros.tracking.translation_filter import CN_WEIGHT
     from scipy import fft as sfft
     import cv2
 
@@ -258,7 +257,6 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     ``search_frame`` is the response's peak.
     """
     from iemd_ros.datasets.otb import read_frame, load_sequence
-    from iemd_ros.tracking.translation_filter import CN_WEIGHT
     from scipy import fft as sfft, signal
 
     seq = load_sequence(uav_root / 'building5')
