@@ -50,10 +50,15 @@ A difference between two trackers is printed run by run (``paired_difference``: 
 in points, its 95 % interval with whole sequences resampled, the runs better, worse and equal; then
 the mean difference per sequence):
 every configuration after the first against the first, and, with ``--against FILE``, every tracker
-of this run against the first of a run saved by ``--save FILE`` (the same starts and shift; another
-source tree, say).  A saved run records the digest of the ``iemd_ros.tracking`` sources it ran and
-when; the comparison prints both digests, so that a reference saved from an older tracker is seen
-as such.
+of this run against the first of a run saved by ``--save FILE`` (the same starts, shift and
+resolution; another source tree, say).  A saved run records the digest of the
+``iemd_ros.tracking`` sources it ran and when; the comparison prints both digests, so that a
+reference saved from an older tracker is seen as such.
+
+``--resolution 0.5`` runs every tracker on the frames resized to half their width and height
+(OpenCV's area interpolation, as a camera binning its pixels) with the ground truth scaled alike:
+footage of lower resolution than the shared sequences, and smaller targets
+(docs/decisions.md#resolution-probe).
 """
 from __future__ import annotations
 
@@ -65,6 +70,7 @@ import json
 from multiprocessing import Pool
 from pathlib import Path
 
+import cv2
 from iemd_ros import TrackerConfig, tracking
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.datasets.otb import load_sequence
@@ -104,10 +110,10 @@ def run(job):
 
     Decoded once.
     """
-    name, runs, shift, starts = job
+    name, runs, shift, starts, resolution = job
     seq = load_sequence(name)
-    frames = list(seq.frames())
-    first = np.asarray(seq.gt_boxes[0], dtype=float)
+    frames, truth = _resized(list(seq.frames()), seq.gt_boxes, resolution)
+    first = truth[0]
     out = []
     for label, tracker_name, config in runs:
         rows = []
@@ -115,10 +121,31 @@ def run(job):
             start = start_box(first, dx, dy, scale, shift)
             tracker = make_tracker(tracker_name, config)
             result = run_tracker(tracker, frames, start)
-            scores = score_sequence(result.boxes, seq.gt_boxes, name)
+            scores = score_sequence(result.boxes, truth, name)
             rows.append((scores.average_overlap, float(np.median(result.update_seconds) * 1e3)))
         out.append(rows)
     return out
+
+
+def _resized(frames: list, boxes, factor: float) -> tuple[list, np.ndarray]:
+    """
+    Return the frames and 0-based ground-truth boxes at ``factor`` times their width and height.
+
+    A box's 0-based corner and size scale alike: pixel ``i`` spans ``[i - 1/2, i + 1/2]`` and the
+    resize maps the image's edges onto each other.
+    """
+    boxes = np.asarray(boxes, dtype=float)
+    if factor == 1.0:
+        return frames, boxes
+    resized = [
+        cv2.resize(
+            f,
+            (max(1, round(f.shape[1] * factor)), max(1, round(f.shape[0] * factor))),
+            interpolation=cv2.INTER_AREA,
+        )
+        for f in frames
+    ]
+    return resized, boxes * factor
 
 
 def main() -> None:
@@ -148,6 +175,12 @@ def main() -> None:
         default='diagonal',
         help='diagonal: the ground truth and 4 diagonal shifts; sre: also 4 axis shifts, 4 scales',
     )
+    parser.add_argument(
+        '--resolution',
+        type=float,
+        default=1.0,
+        help='frames and ground truth resized by this factor, in (0, 1] (default: 1)',
+    )
     parser.add_argument('--jobs', type=int, default=2)
     parser.add_argument(
         '--save', type=Path, help='write the average overlap of every run to this JSON file'
@@ -156,6 +189,8 @@ def main() -> None:
         '--against', type=Path, help='compare with the first tracker of a run saved by --save'
     )
     args = parser.parse_args()
+    if not 0.0 < args.resolution <= 1.0:
+        parser.error(f'--resolution must be in (0, 1], got {args.resolution}')
     names = sequence_names(args.sequences)
     if args.split is not None:
         names = [n for n in names if n in split_names(args.split)]
@@ -163,7 +198,7 @@ def main() -> None:
     reference = (
         None
         if args.against is None
-        else _load_reference(args.against, args.starts, args.shift, names)
+        else _load_reference(args.against, args.starts, args.shift, args.resolution, names)
     )
     digest = _tracker_digest()
     # Checked here, before any run: a bad key or peer fails at once with its own message.
@@ -181,7 +216,12 @@ def main() -> None:
     runs += [(peer, peer, None) for peer in peers]
     with Pool(args.jobs) as pool:
         results = pool.map(
-            run, [(name, runs, args.shift, START_SETS[args.starts]) for name in names], chunksize=1
+            run,
+            [
+                (name, runs, args.shift, START_SETS[args.starts], args.resolution)
+                for name in names
+            ],
+            chunksize=1,
         )
     groups = {n: load_sequence(n).group for n in names}
     n_starts = len(START_SETS[args.starts])
@@ -194,6 +234,7 @@ def main() -> None:
         f'{len(names)} sequences x {n_starts} starts (ground truth, and shifted by {args.shift:g} '
         'of its size '
         f'along {which})'
+        + ('' if args.resolution == 1.0 else f', frames at {args.resolution:g} of their size')
     )
     overlaps = {}
     first = runs[0][0]
@@ -230,6 +271,7 @@ def main() -> None:
                 {
                     'starts': args.starts,
                     'shift': args.shift,
+                    'resolution': args.resolution,
                     'tracker_sources': digest,
                     'saved': datetime.datetime.now().isoformat(timespec='seconds'),
                     'runs': {
@@ -264,25 +306,27 @@ def _tracker_digest() -> str:
 
 
 def _load_reference(
-    path: Path, starts: str, shift: float, names
+    path: Path, starts: str, shift: float, resolution: float, names
 ) -> tuple[str, np.ndarray, str]:
     """
     (label, AO % per sequence of ``names`` and start, source) of the first tracker saved by --save.
 
     Its source: the digest of the tracker sources it ran and when, as far as the file records them.
 
-    SystemExit with one line for a file that is not such a run, or one of other starts or shift, or
-    without a run of one of ``names``.
+    SystemExit with one line for a file that is not such a run, or one of other starts, shift or
+    resolution (a file without one is at full resolution), or without a run of one of ``names``.
     """
     try:
         saved = json.loads(path.read_text())
         label, runs = next(iter(saved['runs'].items()))
     except (OSError, ValueError, KeyError, StopIteration, AttributeError) as exc:
         raise SystemExit(f'--against {path}: not a run saved by --save ({exc})') from None
-    if (saved.get('starts'), saved.get('shift')) != (starts, shift):
+    saved_as = (saved.get('starts'), saved.get('shift'), saved.get('resolution', 1.0))
+    if saved_as != (starts, shift, resolution):
         raise SystemExit(
-            f'--against {path}: saved with --starts {saved.get("starts")} --shift '
-            f'{saved.get("shift")}, this run uses --starts {starts} --shift {shift}'
+            f'--against {path}: saved with --starts {saved_as[0]} --shift {saved_as[1]} '
+            f'--resolution {saved_as[2]}, this run uses --starts {starts} --shift {shift} '
+            f'--resolution {resolution}'
         )
     missing = [n for n in names if n not in runs]
     if missing:
