@@ -131,21 +131,17 @@ def _resized(frames: list, boxes, factor: float) -> tuple[list, np.ndarray]:
     """
     Return the frames and 0-based ground-truth boxes at ``factor`` times their width and height.
 
-    A box's 0-based corner and size scale alike: pixel ``i`` spans ``[i - 1/2, i + 1/2]`` and the
-    resize maps the image's edges onto each other.
+    A box's 0-based corner and size scale by the resized frame's own ratio on each axis: pixel
+    ``i`` spans ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
     """
     boxes = np.asarray(boxes, dtype=float)
     if factor == 1.0:
         return frames, boxes
-    resized = [
-        cv2.resize(
-            f,
-            (max(1, round(f.shape[1] * factor)), max(1, round(f.shape[0] * factor))),
-            interpolation=cv2.INTER_AREA,
-        )
-        for f in frames
-    ]
-    return resized, boxes * factor
+    h, w = frames[0].shape[:2]
+    size = (max(1, round(w * factor)), max(1, round(h * factor)))
+    resized = [cv2.resize(f, size, interpolation=cv2.INTER_AREA) for f in frames]
+    ratio = np.array([size[0] / w, size[1] / h])
+    return resized, boxes * np.tile(ratio, 2)
 
 
 def main() -> None:
