@@ -112,7 +112,7 @@ def run(job):
     """
     name, runs, shift, starts, resolution = job
     seq = load_sequence(name)
-    frames, truth = _resized(list(seq.frames()), seq.gt_boxes, resolution)
+    frames, truth = _resized(seq.frames(), seq.gt_boxes, resolution)
     first = truth[0]
     out = []
     for label, tracker_name, config in runs:
@@ -127,21 +127,23 @@ def run(job):
     return out
 
 
-def _resized(frames: list, boxes, factor: float) -> tuple[list, np.ndarray]:
+def _resized(frames, boxes, factor: float) -> tuple[list, np.ndarray]:
     """
-    Return the frames and 0-based ground-truth boxes at ``factor`` times their width and height.
+    Return the decoded frames and 0-based ground-truth boxes at ``factor`` times their size.
 
-    A box's 0-based corner and size scale by the resized frame's own ratio on each axis: pixel
-    ``i`` spans ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
+    Each frame is resized as it is decoded, so a sequence is never held at both sizes.  A box's
+    0-based corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
+    ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
     """
     boxes = np.asarray(boxes, dtype=float)
     if factor == 1.0:
-        return frames, boxes
-    h, w = frames[0].shape[:2]
-    size = (max(1, round(w * factor)), max(1, round(h * factor)))
-    resized = [cv2.resize(f, size, interpolation=cv2.INTER_AREA) for f in frames]
-    ratio = np.array([size[0] / w, size[1] / h])
-    return resized, boxes * np.tile(ratio, 2)
+        return list(frames), boxes
+    resized = []
+    for frame in frames:
+        h, w = frame.shape[:2]
+        size = (max(1, round(w * factor)), max(1, round(h * factor)))
+        resized.append(cv2.resize(frame, size, interpolation=cv2.INTER_AREA))
+    return resized, boxes * np.tile([size[0] / w, size[1] / h], 2)
 
 
 def main() -> None:
