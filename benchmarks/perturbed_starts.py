@@ -41,8 +41,11 @@ tracker whose result swings with small changes says little.  As OTB's spatial ro
 (SRE) does, every sequence is also started from the ground truth shifted by ``shift`` of its size
 along the four diagonals (5 starts in all); with ``--starts sre`` also along the four axes and with
 the box scaled by 0.8, 0.9, 1.1 and 1.2 about its centre (13 starts: OTB's 8 spatial shifts and 4
-scale variations, and the ground truth).  Each run is scored over all its frames against the ground
-truth (iemd_ros.evaluation.metrics).  Printed per tracker: the mean average overlap over sequences
+scale variations, and the ground truth).  With ``--starts tre``, as OTB's temporal robustness
+evaluation (TRE) does, each sequence is started from the ground truth at 20 evenly spaced frames
+(the first annotated one at or after each) and run to its end: a user starts tracking wherever the
+footage happens to be.  Each run is scored over all its frames against the ground truth
+(iemd_ros.evaluation.metrics).  Printed per tracker: the mean average overlap over sequences
 and starts, its mean per start, per sequence, and the median update time.  ``--config`` runs iEMD
 with other TrackerConfig values (default: the defaults), each against the same peers.
 
@@ -79,18 +82,20 @@ from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.split import PARTS, split_names
 import numpy as np
 
-# Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, and the box's
-# scale.
+# Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, the box's
+# scale, and the fraction of the sequence's frames before the start.
 DIAGONALS = (
-    (0.0, 0.0, 1.0),
-    (1.0, 1.0, 1.0),
-    (-1.0, 1.0, 1.0),
-    (1.0, -1.0, 1.0),
-    (-1.0, -1.0, 1.0),
+    (0.0, 0.0, 1.0, 0.0),
+    (1.0, 1.0, 1.0, 0.0),
+    (-1.0, 1.0, 1.0, 0.0),
+    (1.0, -1.0, 1.0, 0.0),
+    (-1.0, -1.0, 1.0, 0.0),
 )
-AXES = ((1.0, 0.0, 1.0), (-1.0, 0.0, 1.0), (0.0, 1.0, 1.0), (0.0, -1.0, 1.0))
-SCALES = tuple((0.0, 0.0, s) for s in (0.8, 0.9, 1.1, 1.2))
-START_SETS = {'diagonal': DIAGONALS, 'sre': DIAGONALS + AXES + SCALES}
+AXES = tuple((dx, dy, 1.0, 0.0) for dx, dy in ((1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)))
+SCALES = tuple((0.0, 0.0, s, 0.0) for s in (0.8, 0.9, 1.1, 1.2))
+SEGMENTS = 20  # OTB's temporal robustness evaluation: starts at 20 evenly spaced frames
+TEMPORAL = tuple((0.0, 0.0, 1.0, k / SEGMENTS) for k in range(SEGMENTS))
+START_SETS = {'diagonal': DIAGONALS, 'sre': DIAGONALS + AXES + SCALES, 'tre': TEMPORAL}
 
 
 def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: float) -> np.ndarray:
@@ -104,6 +109,20 @@ def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: floa
     )
 
 
+def start_frame(truth: np.ndarray, at: float) -> int:
+    """
+    Return the first frame at or after ``at`` of the sequence where the target is annotated.
+
+    At most the second last frame, so that a run tracks at least one frame; before ``at`` when no
+    later frame is annotated.
+    """
+    n = len(truth)
+    valid = np.flatnonzero(np.all(np.isfinite(truth), axis=1) & np.all(truth[:, 2:] > 0, axis=1))
+    valid = valid[valid <= n - 2]
+    later = valid[valid >= int(at * n)]
+    return int(later[0] if later.size else valid[-1])
+
+
 def run(job):
     """
     [(average overlap, median update ms) per start] of each run on one sequence.
@@ -113,15 +132,15 @@ def run(job):
     name, runs, shift, starts, resolution = job
     seq = load_sequence(name)
     frames, truth = _resized(seq.frames(), seq.gt_boxes, resolution)
-    first = truth[0]
     out = []
     for label, tracker_name, config in runs:
         rows = []
-        for dx, dy, scale in starts:
-            start = start_box(first, dx, dy, scale, shift)
+        for dx, dy, scale, at in starts:
+            k = start_frame(truth, at)
+            start = start_box(truth[k], dx, dy, scale, shift)
             tracker = make_tracker(tracker_name, config)
-            result = run_tracker(tracker, frames, start)
-            scores = score_sequence(result.boxes, truth, name)
+            result = run_tracker(tracker, frames[k:], start)
+            scores = score_sequence(result.boxes, truth[k:], name)
             rows.append((scores.average_overlap, float(np.median(result.update_seconds) * 1e3)))
         out.append(rows)
     return out
@@ -171,7 +190,8 @@ def main() -> None:
         '--starts',
         choices=sorted(START_SETS),
         default='diagonal',
-        help='diagonal: the ground truth and 4 diagonal shifts; sre: also 4 axis shifts, 4 scales',
+        help='diagonal: the ground truth and 4 diagonal shifts; sre: also 4 axis shifts, 4 '
+        f'scales; tre: the ground truth at {SEGMENTS} evenly spaced frames',
     )
     parser.add_argument(
         '--resolution',
@@ -223,15 +243,14 @@ def main() -> None:
         )
     groups = {n: load_sequence(n).group for n in names}
     n_starts = len(START_SETS[args.starts])
-    which = (
-        'the diagonals'
-        if args.starts == 'diagonal'
-        else 'the diagonals and the axes, and scaled by 0.8-1.2'
-    )
+    which = {
+        'diagonal': f'ground truth, and shifted by {args.shift:g} of its size along the diagonals',
+        'sre': f'ground truth, and shifted by {args.shift:g} of its size along the diagonals and '
+        'the axes, and scaled by 0.8-1.2',
+        'tre': f'ground truth at {SEGMENTS} evenly spaced frames, each run to the end',
+    }[args.starts]
     print(
-        f'{len(names)} sequences x {n_starts} starts (ground truth, and shifted by {args.shift:g} '
-        'of its size '
-        f'along {which})'
+        f'{len(names)} sequences x {n_starts} starts ({which})'
         + ('' if args.resolution == 1.0 else f', frames at {args.resolution:g} of their size')
     )
     overlaps = {}
