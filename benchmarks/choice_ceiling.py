@@ -34,7 +34,7 @@ Ceiling of the tracker's choices: its own average overlap against an oracle that
     PYTHONPATH=. python benchmarks/choice_ceiling.py [--split train|validation] [--sequences Car4]
                                                      [--jobs 2]
 
-Every sequence of ``../shared`` (OTB and drone) is tracked from the ground truth four times:
+Every sequence of ``../shared`` (OTB and drone) is tracked from the ground truth five times:
 
 * ``tracker``: the shipped tracker as it is;
 * ``start``: on every annotated frame the search is handed only the start (the prediction, the
@@ -52,6 +52,7 @@ nothing new to find the target; ``scale`` and ``aspect`` are the same for the si
 (docs/decisions.md#choice-ceiling, docs/decisions.md#aspect-ratio).
 """
 import argparse
+import dataclasses
 from multiprocessing import Pool
 import sys
 
@@ -97,12 +98,16 @@ class OracleTracker(IemdTracker):
         if 'scale' in self._oracles and truth is not None:
             scale = float(np.sqrt(truth[2] * truth[3] / np.prod(best.model.size)))
         if 'aspect' in self._oracles and truth is not None:
-            # the same area at the true width / height: a scale per axis (TrackResult.scale then
-            # holds the pair; the evaluation reads only the box)
+            # the same area at the true width / height: a scale per axis (update reports their
+            # geometric mean, the area's scale)
             area = float(np.prod(best.model.size)) * scale ** 2
             ratio = truth[2] / truth[3]
             scale = np.sqrt([area * ratio, area / ratio]) / best.model.size
         return found, scale
+
+    def update(self, frame, prior=None):
+        result = super().update(frame, prior)
+        return dataclasses.replace(result, scale=float(np.sqrt(np.prod(result.scale))))
 
 
 class OracleAdapter(IemdAdapter):
