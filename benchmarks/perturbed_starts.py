@@ -77,7 +77,7 @@ import cv2
 from iemd_ros import TrackerConfig, tracking
 from iemd_ros.common.boxes import box_centre, centre_box
 from iemd_ros.datasets.otb import load_sequence
-from iemd_ros.evaluation.metrics import paired_difference, score_sequence
+from iemd_ros.evaluation.metrics import paired_difference, score_sequence, valid_boxes
 from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.split import PARTS, split_names
 import numpy as np
@@ -117,8 +117,7 @@ def start_frame(truth: np.ndarray, at: float) -> int:
     later frame is annotated.
     """
     n = len(truth)
-    valid = np.flatnonzero(np.all(np.isfinite(truth), axis=1) & np.all(truth[:, 2:] > 0, axis=1))
-    valid = valid[valid <= n - 2]
+    valid = np.flatnonzero(valid_boxes(truth)[: n - 1])
     later = valid[valid >= int(at * n)]
     return int(later[0] if later.size else valid[-1])
 
@@ -132,12 +131,14 @@ def run(job):
     name, runs, shift, starts, resolution = job
     seq = load_sequence(name)
     frames, truth = _resized(seq.frames(), seq.gt_boxes, resolution)
+    begins = []  # (first frame, box) of each start, the same for every tracker
+    for dx, dy, scale, at in starts:
+        k = start_frame(truth, at)
+        begins.append((k, start_box(truth[k], dx, dy, scale, shift)))
     out = []
     for label, tracker_name, config in runs:
         rows = []
-        for dx, dy, scale, at in starts:
-            k = start_frame(truth, at)
-            start = start_box(truth[k], dx, dy, scale, shift)
+        for k, start in begins:
             tracker = make_tracker(tracker_name, config)
             result = run_tracker(tracker, frames[k:], start)
             scores = score_sequence(result.boxes, truth[k:], name)
