@@ -30,7 +30,7 @@
 """
 Staple's colour histograms.
 
-The per-pixel score beta, the window means, the start and the tracker's use.
+The per-pixel score beta, the window means, the start, the mean-shift step and the tracker's use.
 """
 from helpers import run_python, shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
@@ -104,6 +104,51 @@ def test_the_estimate_finds_the_moved_target_at_any_resampling_and_turn():
         assert model.score_at(box_centre(moved)) > 0.9
 
 
+def test_the_mean_shift_step_is_the_beta_weighted_mean_of_the_window():
+    """
+    Target all red (beta 1), surroundings all green (beta 0).
+
+    A 21 x 31 px window 5 px right of and 8 px below the target holds red on its columns -10 .. 5
+    and rows -15 .. 7 from its centre, so its step is their mean, (-2.5, -4); on the target or on
+    bare background it is (0, 0).  Resampled, and in a window turned by 90 degrees (its axes swap
+    width and height), the same step in image pixels.
+    """
+    box = (60, 40, 21, 31)
+    frame, c = _scene(box=box), box_centre(box)
+    for model_area, angle, size in [
+        (10**6, 0.0, box[2:]),
+        (2048, 0.0, box[2:]),
+        (10**6, np.pi / 2, box[:1:-1]),
+    ]:
+        model = ColourModel(model_area=model_area)
+        model.init(frame, c, size, angle)
+        assert np.allclose(model.mean_shift(frame, c + [5.0, 8.0], size, angle), [-2.5, -4.0])
+        assert np.allclose(model.mean_shift(frame, c, size, angle), 0.0)
+        assert np.allclose(model.mean_shift(frame, c + [40.0, 0.0], size, angle), 0.0)
+
+
+def test_a_tracked_window_moves_toward_the_target_colours():
+    """
+    A red square on a grey texture, the first box 6 px right of and below it; 30 frames of it.
+
+    Without the colour model's share (``colour_merge`` 0) the translation filter keeps the first
+    box's offset; with the shipped share the window moves toward the square, ending with at most
+    three quarters of the offset (docs/decisions.md#colour-mean-shift).
+    """
+    scene = np.repeat(texture(seed=3)[..., None], 3, axis=2)
+    scene[40:80, 50:90] = RED
+    offsets = {}
+    for merge in (0.0, TrackerConfig().colour_merge):
+        tracker = IemdTracker(TrackerConfig(colour_merge=merge))
+        tracker.init(scene, (56, 46, 40, 40))
+        for _ in range(30):
+            box = tracker.update(scene).box
+        offsets[merge] = np.hypot(box[0] - 50.0, box[1] - 40.0)
+    first = np.hypot(6.0, 6.0)
+    assert offsets[0.0] > 0.95 * first, offsets
+    assert offsets[TrackerConfig().colour_merge] < 0.75 * first, offsets
+
+
 def test_update_blends_the_histograms_at_the_learning_rate():
     """
     After the target turns blue, one update at rate 0.25 gives beta(blue) = 0.25 /.
@@ -132,10 +177,14 @@ def test_invalid_parameters_and_calls_raise():
             ColourModel(**kwargs)
     with pytest.raises(RuntimeError, match='before init'):
         ColourModel().estimate(_scene(), (70, 55), (20, 30))
+    with pytest.raises(RuntimeError, match='before init'):
+        ColourModel().mean_shift(_scene(), (70, 55), (20, 30))
     with pytest.raises(RuntimeError, match='estimate'):
         ColourModel().score_at((70, 55))
     with pytest.raises(ValueError, match=r'colour_weight must be in \[0, 100\]'):
         TrackerConfig(colour_weight=-1.0)
+    with pytest.raises(ValueError, match=r'colour_merge must be in \[0, 1\]'):
+        TrackerConfig(colour_merge=1.5)
 
 
 def test_the_tracker_uses_colour_on_colour_frames_only():

@@ -46,7 +46,9 @@ The histograms count RGB in ``bins`` levels per channel over the window (the tar
 window grown by half its mean side less the window (the surroundings, Staple's areas), as running
 averages at ``learning_rate``; parts outside the image replicate its border.  The tracker takes the
 position of highest mean as one more start and the mean at each window as evidence in its score, on
-colour frames only (docs/decisions.md#colour-model).
+colour frames only (docs/decisions.md#colour-model); a tracked window then moves by a share of its
+mean-shift step on beta, toward the beta-weighted mean of its pixels
+(docs/decisions.md#colour-mean-shift).
 """
 from __future__ import annotations
 
@@ -234,6 +236,51 @@ class ColourModel:
         top = (1.0 - fc) * means[r0, c0] + fc * means[r0, c1]
         bottom = (1.0 - fc) * means[r1, c0] + fc * means[r1, c1]
         return float((1.0 - fr) * top + fr * bottom)
+
+    def mean_shift(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
+        """
+        Return the mean-shift step of the window on the target's colours.
+
+        The beta-weighted mean of the window's pixel positions less its centre: one step of the
+        mean-shift tracker (Comaniciu, Ramesh, Meer, "Kernel-Based Object Tracking", TPAMI 2003:
+        the new location is the weighted mean of the pixels under the kernel, here flat over the
+        window) with Staple's per-pixel score beta as the weights.
+
+        Parameters
+        ----------
+        frame : ndarray
+            HxWx3 uint8 (BGR) frame.
+        center : array_like
+            (x, y) window centre, image pixels.
+        size : array_like
+            (w, h) window size, image pixels.
+        angle : float, optional
+            The window's turn, radians.
+
+        Returns
+        -------
+        ndarray
+            (dx, dy), image pixels; (0, 0) where no pixel of the window has a target colour.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`init`.
+
+        """
+        if not self.trained:
+            raise RuntimeError('ColourModel.mean_shift() called before init()')
+        bins, scale = self._bin_indices(frame, center, np.asarray(size, dtype=np.float64), angle)
+        beta = self._beta[bins]
+        total = float(beta.sum())
+        if total <= 0.0:
+            return np.zeros(2)
+        rows, cols = beta.shape
+        mean = np.array([
+            beta.sum(axis=0) @ (np.arange(cols) - (cols - 1) / 2.0),
+            beta.sum(axis=1) @ (np.arange(rows) - (rows - 1) / 2.0),
+        ]) / total
+        return window_axes(angle) @ (mean / scale)
 
     def _histograms(self, frame, center, size, angle):
         """

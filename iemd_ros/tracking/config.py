@@ -202,6 +202,13 @@ class TrackerConfig:
         range=(0.0, 100.0),
         decision='colour-model',
     )
+    colour_merge: float = param(
+        0.3,
+        "share of the colour model's mean-shift step a tracked window moves by, colour "
+        "frames only (Staple's merge factor; 0: none)",
+        range=(0.0, 1.0),
+        decision='colour-mean-shift',
+    )
     motion_weight: float = param(
         0.05,
         "weight of the squared displacement from the prediction over the window's "

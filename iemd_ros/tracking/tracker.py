@@ -360,6 +360,12 @@ class IemdTracker:
                 frame, best, _scale_bounds(best.model.size, frame.shape)
             )
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
+        # the colour model's position merged in as Staple merges its responses: a share of the
+        # window's mean-shift step on the target's colours (docs/decisions.md#colour-mean-shift)
+        if self._colour_now and cfg.colour_merge > 0 and not best.held_reason and not self._lost:
+            new_center = new_center + cfg.colour_merge * self._colour_model.mean_shift(
+                frame, new_center, new_size, angle
+            )
         codings = sum(s.codings for s in searches) + final.codings
         cause, reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
         if cause is None:  # lost until the peak is back to found_response x its mean: hysteresis

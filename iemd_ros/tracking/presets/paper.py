@@ -56,6 +56,7 @@ def parameters() -> TrackerConfig:
         flow_start=False,
         translation_weight=0.0,
         colour_weight=0.0,
+        colour_merge=0.0,
         motion_weight=0.0,
         update_confidence=0.0,
     )
