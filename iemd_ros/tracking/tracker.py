@@ -41,8 +41,10 @@ model's windows) are compared by the EMD between their sparse-coding histograms 
 and by the search's score; with ``n_iter`` > 0 the best by EMD and the best by score are descended
 (Algorithm 1: move against the EMD's gradient while it decreases; the ``paper`` preset descends,
 the default does not: docs/decisions.md#descent-off); the window of lower score is kept,
-preferring one the occlusion check accepts; then the scale is estimated at it, and the models learn
-unless the frame is held or lost: after ``update`` has returned, on a thread of their own.
+preferring one the occlusion check accepts; then the scale is estimated at it, on a tracked colour
+frame the window moves by ``colour_merge`` of its mean-shift step on the colour model's beta, and
+the models learn unless the frame is held or lost: after ``update`` has returned, on a thread of
+their own.
 """
 from __future__ import annotations
 
