@@ -355,16 +355,17 @@ class IemdTracker:
         best, searches, starts = self._search_all(
             frame, flow, filter_move, confident, pyramid, center, size, angle
         )
-        # held or lost: the window keeps its size
+        # held or lost: the window keeps its size and takes no colour step
+        tracked = not best.held_reason and not self._lost
         final, scale = _Descent(model=best.model, emd=best.emd), 1.0
-        if not best.held_reason and not self._lost:
+        if tracked:
             final, scale = self._estimate_scale(
                 frame, best, _scale_bounds(best.model.size, frame.shape)
             )
         emd, new_center, new_size = final.emd, final.center, best.model.size * scale
         # the colour model's position merged in as Staple merges its responses: a share of the
         # window's mean-shift step on the target's colours (docs/decisions.md#colour-mean-shift)
-        if self._colour_now and cfg.colour_merge > 0 and not best.held_reason and not self._lost:
+        if tracked and self._colour_now and cfg.colour_merge > 0:
             new_center = new_center + cfg.colour_merge * self._colour_model.mean_shift(
                 frame, new_center, new_size, angle
             )
