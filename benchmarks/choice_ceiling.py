@@ -107,7 +107,8 @@ class OracleTracker(IemdTracker):
 
     def update(self, frame, prior=None):
         result = super().update(frame, prior)
-        return dataclasses.replace(result, scale=float(np.sqrt(np.prod(result.scale))))
+        # the geometric mean: the aspect oracle's pair gives its area's scale, one scale itself
+        return dataclasses.replace(result, scale=float(np.exp(np.mean(np.log(result.scale)))))
 
 
 class OracleAdapter(IemdAdapter):
