@@ -168,6 +168,24 @@ def test_update_blends_the_histograms_at_the_learning_rate():
     assert model.score_at(box_centre(box) + [10.5, 0.0]) == pytest.approx(0.5)
 
 
+def test_pixel_scores_give_each_pixel_its_beta_and_keep_their_table():
+    """
+    Target red, surroundings green: a pixel scores 1 on red, 0 on green and on blue (on neither).
+
+    After the target turns blue and the model learns at rate 0.25, a scorer made before still gives
+    blue 0; one made after gives it 0.25 / (0.25 + 0) = 1, and red 0.75 / 0.75 = 1.
+    """
+    box = (60, 40, 21, 31)
+    model = ColourModel(learning_rate=0.25, model_area=10**6)
+    model.init(_scene(box=box), box_centre(box), box[2:])
+    before = model.pixel_scores()
+    patch = np.array([[RED, GREEN, BLUE], [BLUE, RED, RED]], np.uint8)
+    np.testing.assert_array_equal(before(patch), [[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
+    model.update(_scene(target=BLUE, box=box), box_centre(box), box[2:])
+    np.testing.assert_array_equal(before(patch), [[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
+    np.testing.assert_allclose(model.pixel_scores()(patch), [[1.0, 0.0, 1.0], [1.0, 1.0, 1.0]])
+
+
 def test_invalid_parameters_and_calls_raise():
     for kwargs, message in [
         ({'padding': -1.0}, 'padding'),
@@ -181,6 +199,8 @@ def test_invalid_parameters_and_calls_raise():
         ColourModel().estimate(_scene(), (70, 55), (20, 30))
     with pytest.raises(RuntimeError, match='before init'):
         ColourModel().mean_shift(_scene(), (70, 55), (20, 30))
+    with pytest.raises(RuntimeError, match='before init'):
+        ColourModel().pixel_scores()
     with pytest.raises(RuntimeError, match='estimate'):
         ColourModel().score_at((70, 55))
     with pytest.raises(ValueError, match=r'colour_weight must be in \[0, 100\]'):

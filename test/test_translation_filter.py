@@ -32,7 +32,7 @@ The translation filter (STRCF) and the tracker's use of its response.
 
 The filter is iemd_ros/tracking/translation_filter.py.
 """
-from helpers import shifted
+from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
 from iemd_ros.tracking import features
@@ -110,6 +110,92 @@ def test_the_sample_weighs_colour_names_against_fhog_and_grey(colour):
     expected[features.CN_START:] *= CN_WEIGHT
     got = sfft.irfft2(region.zf, s=tf.map_hw)
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-5 * np.abs(expected).max())
+
+
+def _red_square_on_green(shape=(240, 320), box=(140, 100, 41, 33)):
+    """Return a red rectangle at ``box`` on a green frame, a grey texture in both (BGR)."""
+    frame = np.repeat(texture(seed=5, shape=shape)[..., None] // 4, 3, axis=2)
+    frame[..., 1] += 160
+    x, y, w, h = box
+    frame[y:y + h, x:x + w, 1] -= 160
+    frame[y:y + h, x:x + w, 2] += 160
+    return frame
+
+
+def test_a_colour_model_adds_its_score_averaged_over_each_cell_as_one_more_channel():
+    """
+    With a colour model the sample has one channel more, weighed as grey: beta per cell, less 1/2.
+
+    A red rectangle on green, both textured, sized so that the region is not resampled: the model's
+    beta is 1 on the rectangle's colours and 0 on the green's, so the last channel of the sample,
+    over the cosine window, is the share of a cell's pixels on the rectangle less 1/2 (counted here
+    from the region's red channel).  The estimate's sample and a new sample of the same region,
+    which the filter learns from when the estimate's cannot be shifted, are the same; without the
+    model there are 42.
+    """
+    from iemd_ros.tracking.colour_model import ColourModel
+    from iemd_ros.tracking.correlation_filter import hann_inner
+    from scipy import fft as sfft
+
+    box = (140, 100, 33, 29)  # 25 w h within [150^2, 160^2]: no resampling
+    frame = _red_square_on_green(box=box)
+    centre, size = box_centre(box), np.array(box[2:], float)
+    model = ColourModel()
+    model.init(frame, centre, size)
+    tf = TranslationFilter()
+    tf.init(frame, centre, size, colour=True, colour_model=model)
+    plain = TranslationFilter()
+    plain.init(frame, centre, size, colour=True)
+    assert (tf.n_channels, plain.n_channels) == (43, 42)
+    assert tf._scale(size) == 1.0
+    region = tf.sample(frame, centre, size)
+    tf.estimate(region)
+    got = sfft.irfft2(tf._detection.zf, s=tf.map_hw)
+    assert len(got) == 43
+    on_red = (region.patch[..., 2] > region.patch[..., 1]).astype(float)
+    n = tf.map_hw[0]
+    share = on_red[:n * 4, :n * 4].reshape(n, 4, n, 4).mean(axis=(1, 3))
+    assert 0.0 < share.mean() < 0.2 and share.max() == 1.0  # the region holds both colours
+    window = hann_inner(n)[:, None] * hann_inner(n)[None, :]
+    np.testing.assert_allclose(got[-1], (share - 0.5) * window, atol=1e-4)
+    again = tf._spectrum(frame, region.pos, region.scale, region.angle)
+    np.testing.assert_allclose(again, tf._detection.zf, atol=1e-3)
+
+
+def test_a_frame_is_scored_by_the_colour_model_as_it_was_at_the_estimate():
+    """
+    The colour model learns on a worker thread while the filter learns from the same frame.
+
+    Two filters learned alike, each with its colour model; between the estimate and the update on
+    the next frame (at a size 20 % larger, so the filter takes a new sample rather than shifting
+    the estimate's), one model learns a frame all in the rectangle's red, which lowers red's beta
+    from 1 to 1 / 1.5.  Both filters learn the same filter: the new sample is scored as the model
+    was at the estimate.  Scored with the model after learning, its colour channel would differ.
+    """
+    from iemd_ros.tracking.colour_model import ColourModel
+
+    box = (140, 100, 41, 33)
+    frame = _red_square_on_green(box=box)
+    centre, size = box_centre(box), np.array(box[2:], float)
+    red = frame.copy()
+    red[..., 1], red[..., 2] = frame[..., 0], frame[..., 0] + 160
+    moved, at = shifted(frame, 3.0, -2.0), centre + (3.0, -2.0)
+    filters = []
+    for learns in (False, True):
+        model = ColourModel(learning_rate=0.5)
+        model.init(frame, centre, size)
+        tf = TranslationFilter()
+        tf.init(frame, centre, size, colour=True, colour_model=model)
+        tf.estimate(tf.sample(moved, centre, size))
+        if learns:
+            model.update(red, centre, size)
+        tf.update(moved, at, size * 1.2)
+        filters.append(tf.f)
+    np.testing.assert_array_equal(filters[0], filters[1])
+    patch = tf._patch(moved, np.round(at), tf._scale(size * 1.2), 0.0)
+    at_estimate = tf._colour_channel(patch)
+    tf._scores = model.pixel_scores()
+    assert not np.allclose(tf._colour_channel(patch), at_estimate, atol=0.05)
 
 
 def test_response_at_reads_the_map_between_cells(car4_first):

@@ -52,6 +52,8 @@ mean-shift step on beta, toward the beta-weighted mean of its pixels
 """
 from __future__ import annotations
 
+from typing import Callable
+
 import cv2
 from iemd_ros.tracking.appearance import warp_window, window_axes
 import numba
@@ -281,6 +283,30 @@ class ColourModel:
             beta.sum(axis=1) @ (np.arange(rows) - (rows - 1) / 2.0),
         ]) / total
         return window_axes(angle) @ (mean / scale)
+
+    def pixel_scores(self) -> Callable[[np.ndarray], np.ndarray]:
+        """
+        Return Staple's per-pixel score beta as the histograms are now, as a function of a patch.
+
+        The function maps an (H, W, 3) uint8 BGR patch to its (H, W) float32 beta, each pixel
+        scored by its colour bin.  It keeps the table it was made with, so a later :meth:`update`
+        does not change it: a model learning on another thread cannot change a sample half-way.
+
+        Returns
+        -------
+        callable
+            ``scores(patch) -> beta``.
+
+        Raises
+        ------
+        RuntimeError
+            Before :meth:`init`.
+
+        """
+        if not self.trained:
+            raise RuntimeError('ColourModel.pixel_scores() called before init()')
+        table, shift, bins = self._beta.astype(np.float32), self._shift, self.bins
+        return lambda patch: table[_bin_index(np.ascontiguousarray(patch), shift, bins)]
 
     def _histograms(self, frame, center, size, angle):
         """

@@ -244,14 +244,20 @@ class IemdTracker:
         if cfg.scale_estimator is ScaleEstimator.FILTER and cfg.scale_step > 0:
             self._scale_filter = ScaleFilter(scale_step=1.0 + cfg.scale_step)
             self._scale_filter.init(frame, self._center, self._size)
-        self._translation_filter = None
-        if cfg.translation_weight > 0:
-            self._translation_filter = TranslationFilter()
-            self._translation_filter.init(frame, self._center, self._size, _is_colour(frame))
         self._colour_model = None
         if cfg.colour_weight > 0 and _is_colour(frame):
             self._colour_model = ColourModel()
             self._colour_model.init(frame, self._center, self._size)
+        self._translation_filter = None
+        if cfg.translation_weight > 0:
+            self._translation_filter = TranslationFilter()
+            self._translation_filter.init(
+                frame,
+                self._center,
+                self._size,
+                _is_colour(frame),
+                colour_model=self._colour_model,
+            )
         # the colour model has estimated on this frame (not on a grey frame)
         self._colour_now = False
         self._frame_index = 0

@@ -39,7 +39,10 @@ complementary view (docs/decisions.md#strcf).
 
 * Features (:mod:`iemd_ros.tracking.features`): grey + fHOG + Colour Names on 4x4 cells (42
   channels; 32 on grey frames), the feature set of STRCF and AutoTrack; the Colour Names weighted
-  by ``CN_WEIGHT`` against fHOG and grey (docs/decisions.md#colour-names-weight).
+  by ``CN_WEIGHT`` against fHOG and grey (docs/decisions.md#colour-names-weight).  With a colour
+  model (:class:`~iemd_ros.tracking.colour_model.ColourModel`), one more channel: its per-pixel
+  score beta (Staple) averaged over each cell, less 1/2 as grey is, weighted as grey
+  (docs/decisions.md#colour-score-channel).
 * Sample: a square region of side ``SEARCH_AREA_SCALE`` x ``sqrt(w h)`` of the target, turned with
   the window, resampled so that its area lies in ``[150^2, 160^2]`` px (at most 40 x 40 cells); a
   cosine window; a Gaussian label of std ``sqrt(w h) / cell / 16`` cells.
@@ -60,8 +63,10 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import cv2
 from iemd_ros.tracking import features
 from iemd_ros.tracking.appearance import window_axes
+from iemd_ros.tracking.colour_model import ColourModel
 from iemd_ros.tracking.correlation_filter import (
     apce,
     correlate,
@@ -97,6 +102,7 @@ class Region(NamedTuple):
     scale: float         # image px per sample px
     angle: float         # the region's turn, radians
     zf: np.ndarray       # (C, n, n // 2 + 1) spectrum of the windowed features
+    patch: np.ndarray | None  # the resampled region, kept for the colour channel (else None)
 
 
 class TranslationFilter:
@@ -114,8 +120,17 @@ class TranslationFilter:
         # frame_response
         self._frame_filter = None
         self.response_peak = None  # the last estimate's peak value
+        self.colour_model = self._scores = None
 
-    def init(self, frame: np.ndarray, center, size, colour: bool, angle: float = 0.0) -> None:
+    def init(
+        self,
+        frame: np.ndarray,
+        center,
+        size,
+        colour: bool,
+        angle: float = 0.0,
+        colour_model: ColourModel | None = None,
+    ) -> None:
         """
         Set up the sample geometry from the first window and learn the first filter (``mu = 0``).
 
@@ -129,10 +144,17 @@ class TranslationFilter:
             Whether the sequence has colour (Colour Names are used on colour frames only).
         angle : float
             The window's turn (radians).
+        colour_model : ColourModel, optional
+            A trained colour model whose per-pixel score is one more feature channel; the caller
+            keeps it learning.  Without it the features are grey, fHOG and Colour Names only.
 
         """
         w, h = max(float(size[0]), 1.0), max(float(size[1]), 1.0)
         self.colour = bool(colour)
+        self.colour_model = colour_model
+        # the colour model's per-pixel score as it was at the last estimate (or at init): the
+        # samples of one frame are scored alike while the model learns on another thread
+        self._scores = None if colour_model is None else colour_model.pixel_scores()
         area = w * h * SEARCH_AREA_SCALE ** 2
         s0 = np.sqrt(area / np.clip(area, *SAMPLE_AREA))
         # the target's size in the resampled sample, px
@@ -142,8 +164,8 @@ class TranslationFilter:
         self.support = float(n * features.CELL)            # the resampled sample's side, px
         self.T = n * n
         # each feature channel's weight, and the cosine window times it
-        self.channel_weight = np.ones(features.n_channels(self.colour), np.float32)
-        self.channel_weight[features.CN_START:] = CN_WEIGHT
+        self.channel_weight = np.ones(self.n_channels, np.float32)
+        self.channel_weight[features.CN_START:features.n_channels(self.colour)] = CN_WEIGHT
         self.window = (
             self.channel_weight[:, None, None] * (hann_inner(n)[:, None] * hann_inner(n)[None, :])
         ).astype(np.float32)
@@ -190,13 +212,15 @@ class TranslationFilter:
         """
         scale = self._scale(size)
         pos = self._position(center, angle)
+        patch = self._patch(frame, pos, scale, angle)
         return Region(
             id(frame),
             np.asarray(center, dtype=np.float64),
             pos,
             scale,
             angle,
-            self._spectrum(frame, pos, scale, angle),
+            self._feature_spectrum(patch),
+            None if self.colour_model is None else patch,
         )
 
     def estimate(self, region: Region) -> np.ndarray:
@@ -204,6 +228,8 @@ class TranslationFilter:
         Displacement (dx, dy) px from the region's window centre to where the response peaks.
 
         The response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
+        With a colour model, the region's colour channel is added here, scored by the model as it
+        is now: call it when the model is not learning.
 
         Parameters
         ----------
@@ -216,6 +242,11 @@ class TranslationFilter:
             (2,) displacement, image px.
 
         """
+        if self.colour_model is not None:
+            self._scores = self.colour_model.pixel_scores()
+            region = region._replace(
+                zf=np.concatenate([region.zf, self._colour_spectrum(region.patch)]), patch=None
+            )
         rf = np.empty(region.zf.shape[1:], np.complex64)
         correlate(self.f, region.zf, rf)
         resp = sfft.irfft2(rf, s=self.map_hw)
@@ -328,7 +359,7 @@ class TranslationFilter:
             ((hi - lo) * cell_px[0], rows),
             ((hi - lo) * features.CELL, cells[0] * features.CELL),
         )
-        z = features.extract(strip, self.colour)
+        z = self._features(strip)
         z *= self.channel_weight[:, None, None]
         # sizes the FFT factors well
         shape = tuple(
@@ -469,12 +500,53 @@ class TranslationFilter:
         c = np.asarray(center, dtype=np.float64)
         return np.round(c) if angle == 0.0 else c
 
-    def _spectrum(self, frame: np.ndarray, pos, scale: float, angle: float) -> np.ndarray:
+    @property
+    def n_channels(self) -> int:
+        """Return the feature channels: :func:`features.n_channels`, and the colour channel."""
+        return features.n_channels(self.colour) + (self.colour_model is not None)
+
+    def _patch(self, frame: np.ndarray, pos, scale: float, angle: float) -> np.ndarray:
+        """Return the search region at ``pos``, resampled to the filter's sample."""
         side = self.support * scale
-        patch = sample_region(frame, pos, (side, side), (self.support, self.support), angle)
+        return sample_region(frame, pos, (side, side), (self.support, self.support), angle)
+
+    def _colour_channel(self, patch: np.ndarray) -> np.ndarray:
+        """
+        Return the colour model's score of ``patch``'s pixels averaged over each cell, less 1/2.
+
+        The score is the one of the last estimate (``_scores``); pixels beyond the last full cell
+        are ignored, as :func:`features.extract` ignores them.
+        """
+        rows, cols = patch.shape[0] // features.CELL, patch.shape[1] // features.CELL
+        beta = self._scores(patch)[:rows * features.CELL, :cols * features.CELL]
+        # an integer shrink by area is the mean over each cell
+        return cv2.resize(beta, (cols, rows), interpolation=cv2.INTER_AREA) - np.float32(0.5)
+
+    def _features(self, patch: np.ndarray) -> np.ndarray:
+        """Return every feature channel of ``patch`` (:func:`features.extract`, the colour's)."""
         x = features.extract(patch, self.colour)
-        x *= self.window
+        if self.colour_model is None:
+            return x
+        return np.concatenate([x, self._colour_channel(patch)[None]])
+
+    def _feature_spectrum(self, patch: np.ndarray) -> np.ndarray:
+        """Return the spectrum of the windowed :func:`features.extract` channels of ``patch``."""
+        x = features.extract(patch, self.colour)
+        x *= self.window[:len(x)]
         return sfft.rfft2(x).astype(np.complex64, copy=False)
+
+    def _colour_spectrum(self, patch: np.ndarray) -> np.ndarray:
+        """Return the (1, n, n // 2 + 1) spectrum of the windowed colour channel of ``patch``."""
+        x = self._colour_channel(patch) * self.window[-1]
+        return sfft.rfft2(x)[None].astype(np.complex64, copy=False)
+
+    def _spectrum(self, frame: np.ndarray, pos, scale: float, angle: float) -> np.ndarray:
+        """Return the spectrum of every windowed feature channel of the region at ``pos``."""
+        patch = self._patch(frame, pos, scale, angle)
+        xf = self._feature_spectrum(patch)
+        if self.colour_model is None:
+            return xf
+        return np.concatenate([xf, self._colour_spectrum(patch)])
 
 
 def _bilinear_circular(resp: np.ndarray, y: float, x: float) -> float:
