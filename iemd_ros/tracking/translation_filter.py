@@ -502,7 +502,7 @@ class TranslationFilter:
 
     @property
     def n_channels(self) -> int:
-        """Return the feature channels: :func:`features.n_channels`, and the colour channel."""
+        """Return how many feature channels: :func:`features.n_channels`, and the colour's."""
         return features.n_channels(self.colour) + (self.colour_model is not None)
 
     def _patch(self, frame: np.ndarray, pos, scale: float, angle: float) -> np.ndarray:
