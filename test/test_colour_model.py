@@ -184,6 +184,10 @@ def test_pixel_scores_give_each_pixel_its_beta_and_keep_their_table():
     model.update(_scene(target=BLUE, box=box), box_centre(box), box[2:])
     np.testing.assert_array_equal(before(patch), [[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
     np.testing.assert_allclose(model.pixel_scores()(patch), [[1.0, 0.0, 1.0], [1.0, 1.0, 1.0]])
+    # a grey patch is scored as the colours of three equal levels: here none is in either histogram
+    grey = np.array([[0, 128, 255]], np.uint8)
+    np.testing.assert_array_equal(before(grey), [[0.0, 0.0, 0.0]])
+    np.testing.assert_array_equal(before(grey[..., None]), before(np.dstack([grey] * 3)))
 
 
 def test_invalid_parameters_and_calls_raise():

@@ -32,6 +32,7 @@ The translation filter (STRCF) and the tracker's use of its response.
 
 The filter is iemd_ros/tracking/translation_filter.py.
 """
+import cv2
 from helpers import shifted, texture
 from iemd_ros import IemdTracker, TrackerConfig
 from iemd_ros.common.boxes import box_centre
@@ -92,7 +93,6 @@ def test_the_sample_weighs_colour_names_against_fhog_and_grey(colour):
     """
     from iemd_ros.tracking.correlation_filter import hann_inner, sample_region
     from scipy import fft as sfft
-    import cv2
 
     rng = np.random.default_rng(3)
     frame = cv2.GaussianBlur(rng.integers(0, 256, (240, 320, 3), dtype=np.uint8), (0, 0), 3)
@@ -196,6 +196,24 @@ def test_a_frame_is_scored_by_the_colour_model_as_it_was_at_the_estimate():
     at_estimate = tf._colour_channel(patch)
     tf._scores = model.pixel_scores()
     assert not np.allclose(tf._colour_channel(patch), at_estimate, atol=0.05)
+
+
+def test_a_grey_frame_in_a_colour_stream_is_tracked_with_the_colour_channel():
+    """
+    A grey frame in a colour stream (a camera switching modes) is answered.
+
+    The filter's colour channel scores its levels as colours; on the next colour frame, whose
+    filter estimate may be confident with no colour estimate since the first frame, the tracker
+    follows the target.
+    """
+    box = (140, 100, 41, 33)
+    frame = _red_square_on_green(box=box)
+    tracker = IemdTracker()
+    tracker.init(frame, box)
+    assert tracker._translation_filter.n_channels == 43
+    tracker.update(cv2.cvtColor(shifted(frame, 3.0, 0.0), cv2.COLOR_BGR2GRAY))
+    result = tracker.update(shifted(frame, 6.0, 0.0))
+    assert abs(result.box[0] - 146.0) < 2.0, result.box
 
 
 def test_response_at_reads_the_map_between_cells(car4_first):

@@ -289,8 +289,10 @@ class ColourModel:
         Return Staple's per-pixel score beta as the histograms are now, as a function of a patch.
 
         The function maps an (H, W, 3) uint8 BGR patch to its (H, W) float32 beta, each pixel
-        scored by its colour bin.  It keeps the table it was made with, so a later :meth:`update`
-        does not change it: a model learning on another thread cannot change a sample half-way.
+        scored by its colour bin; a grey patch, (H, W) or (H, W, 1) (a grey frame in a colour
+        stream), is scored as the colours of three equal levels.  It keeps the table it was made
+        with, so a later :meth:`update` does not change it: a model learning on another thread
+        cannot change a sample half-way.
 
         Returns
         -------
@@ -306,7 +308,13 @@ class ColourModel:
         if not self.trained:
             raise RuntimeError('ColourModel.pixel_scores() called before init()')
         table, shift, bins = self._beta.astype(np.float32), self._shift, self.bins
-        return lambda patch: table[_bin_index(np.ascontiguousarray(patch), shift, bins)]
+
+        def scores(patch: np.ndarray) -> np.ndarray:
+            if patch.ndim == 2 or patch.shape[2] == 1:
+                patch = np.repeat(patch.reshape(*patch.shape[:2], 1), 3, axis=2)
+            return table[_bin_index(np.ascontiguousarray(patch), shift, bins)]
+
+        return scores
 
     def _histograms(self, frame, center, size, angle):
         """
