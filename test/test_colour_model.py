@@ -133,8 +133,7 @@ def test_a_tracked_window_moves_toward_the_target_colours():
 
     Without the colour model's share (``colour_merge`` 0) the translation filter keeps the first
     box's offset; with the shipped share the window's centre moves toward the square's, ending with
-    at most 85 % of the offset (about 76 % measured, 111 % without the step;
-    docs/decisions.md#colour-mean-shift).
+    at most 85 % of the offset (docs/decisions.md#colour-mean-shift).
     """
     scene = np.repeat(texture(seed=3)[..., None], 3, axis=2)
     scene[40:80, 50:90] = RED

@@ -105,6 +105,7 @@ class ColourModel:
         self._target = self._surroundings = None  # rho_O and rho_B, (bins**3,)
         # (mean beta per window position, origin, region centre, model px per image px, angle)
         self._means = None
+        self._scores = None  # pixel_scores() of the current beta, made on first use
 
     @property
     def trained(self) -> bool:
@@ -113,7 +114,9 @@ class ColourModel:
 
     def init(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
         """
-        Learn the histograms from the window of the first frame.
+        Learn the histograms from the window of the first frame, and estimate there.
+
+        So :meth:`score_at` answers from the first frame on, also before a later frame's estimate.
 
         Parameters
         ----------
@@ -132,7 +135,8 @@ class ColourModel:
         self._target, self._surroundings, self._beta = _blend(
             target, surroundings, target, surroundings, 1.0
         )
-        self._means = None
+        self._scores = None
+        self.estimate(frame, center, size, angle)
 
     def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
         """
@@ -154,6 +158,7 @@ class ColourModel:
         self._target, self._surroundings, self._beta = _blend(
             self._target, self._surroundings, target, surroundings, self.learning_rate
         )
+        self._scores = None
 
     def estimate(self, frame: np.ndarray, center, size, angle: float = 0.0) -> np.ndarray:
         """
@@ -250,14 +255,8 @@ class ColourModel:
 
         Parameters
         ----------
-        frame : ndarray
-            HxWx3 uint8 (BGR) frame.
-        center : array_like
-            (x, y) window centre, image pixels.
-        size : array_like
-            (w, h) window size, image pixels.
-        angle : float, optional
-            The window's turn, radians.
+        frame, center, size, angle
+            The frame and the window, as for :meth:`estimate`.
 
         Returns
         -------
@@ -292,7 +291,7 @@ class ColourModel:
         scored by its colour bin; a grey patch, (H, W) or (H, W, 1) (a grey frame in a colour
         stream), is scored as the colours of three equal levels.  It keeps the table it was made
         with, so a later :meth:`update` does not change it: a model learning on another thread
-        cannot change a sample half-way.
+        cannot change a sample half-way.  Until then every call returns the same function.
 
         Returns
         -------
@@ -307,14 +306,16 @@ class ColourModel:
         """
         if not self.trained:
             raise RuntimeError('ColourModel.pixel_scores() called before init()')
-        table, shift, bins = self._beta.astype(np.float32), self._shift, self.bins
+        if self._scores is None:
+            table, shift, bins = self._beta.astype(np.float32), self._shift, self.bins
 
-        def scores(patch: np.ndarray) -> np.ndarray:
-            if patch.ndim == 2 or patch.shape[2] == 1:
-                patch = np.repeat(patch.reshape(*patch.shape[:2], 1), 3, axis=2)
-            return table[_bin_index(np.ascontiguousarray(patch), shift, bins)]
+            def scores(patch: np.ndarray) -> np.ndarray:
+                if patch.ndim == 2 or patch.shape[2] == 1:
+                    patch = np.repeat(patch.reshape(*patch.shape[:2], 1), 3, axis=2)
+                return table[_bin_index(np.ascontiguousarray(patch), shift, bins)]
 
-        return scores
+            self._scores = scores
+        return self._scores
 
     def _histograms(self, frame, center, size, angle):
         """

@@ -205,7 +205,7 @@ class TrackerConfig:
     colour_merge: float = param(
         0.3,
         "share of the colour model's mean-shift step a tracked window moves by, colour "
-        "frames only (Staple's merge factor; 0: none)",
+        'frames only (0: none)',
         range=(0.0, 1.0),
         decision='colour-mean-shift',
     )

@@ -248,9 +248,6 @@ class IemdTracker:
         if cfg.colour_weight > 0 and _is_colour(frame):
             self._colour_model = ColourModel()
             self._colour_model.init(frame, self._center, self._size)
-            # the score reads the last estimate's means, also on a confident colour frame that
-            # follows grey ones (a colour frame that is not confident estimates anew)
-            self._colour_model.estimate(frame, self._center, self._size)
         self._translation_filter = None
         if cfg.translation_weight > 0:
             self._translation_filter = TranslationFilter()

@@ -219,7 +219,7 @@ class TranslationFilter:
             pos,
             scale,
             angle,
-            self._feature_spectrum(patch),
+            self._windowed_spectrum(features.extract(patch, self.colour)),
             None if self.colour_model is None else patch,
         )
 
@@ -244,8 +244,10 @@ class TranslationFilter:
         """
         if self.colour_model is not None:
             self._scores = self.colour_model.pixel_scores()
+            colour = self._colour_channel(region.patch)[None]
             region = region._replace(
-                zf=np.concatenate([region.zf, self._colour_spectrum(region.patch)]), patch=None
+                zf=np.concatenate([region.zf, self._windowed_spectrum(colour, len(region.zf))]),
+                patch=None,
             )
         rf = np.empty(region.zf.shape[1:], np.complex64)
         correlate(self.f, region.zf, rf)
@@ -529,24 +531,13 @@ class TranslationFilter:
             return x
         return np.concatenate([x, self._colour_channel(patch)[None]])
 
-    def _feature_spectrum(self, patch: np.ndarray) -> np.ndarray:
-        """Return the spectrum of the windowed :func:`features.extract` channels of ``patch``."""
-        x = features.extract(patch, self.colour)
-        x *= self.window[:len(x)]
-        return sfft.rfft2(x).astype(np.complex64, copy=False)
-
-    def _colour_spectrum(self, patch: np.ndarray) -> np.ndarray:
-        """Return the (1, n, n // 2 + 1) spectrum of the windowed colour channel of ``patch``."""
-        x = self._colour_channel(patch) * self.window[-1]
-        return sfft.rfft2(x)[None].astype(np.complex64, copy=False)
+    def _windowed_spectrum(self, x: np.ndarray, first: int = 0) -> np.ndarray:
+        """Return the spectrum of feature channels ``x``, the filter's ``first`` on, windowed."""
+        return sfft.rfft2(x * self.window[first:first + len(x)]).astype(np.complex64, copy=False)
 
     def _spectrum(self, frame: np.ndarray, pos, scale: float, angle: float) -> np.ndarray:
         """Return the spectrum of every windowed feature channel of the region at ``pos``."""
-        patch = self._patch(frame, pos, scale, angle)
-        xf = self._feature_spectrum(patch)
-        if self.colour_model is None:
-            return xf
-        return np.concatenate([xf, self._colour_spectrum(patch)])
+        return self._windowed_spectrum(self._features(self._patch(frame, pos, scale, angle)))
 
 
 def _bilinear_circular(resp: np.ndarray, y: float, x: float) -> float:
