@@ -310,8 +310,7 @@ class ColourModel:
             table, shift, bins = self._beta.astype(np.float32), self._shift, self.bins
 
             def scores(patch: np.ndarray) -> np.ndarray:
-                if patch.ndim == 2 or patch.shape[2] == 1:
-                    patch = np.repeat(patch.reshape(*patch.shape[:2], 1), 3, axis=2)
+                patch = patch[:, :, None] if patch.ndim == 2 else patch
                 return table[_bin_index(np.ascontiguousarray(patch), shift, bins)]
 
             self._scores = scores
@@ -345,14 +344,18 @@ class ColourModel:
 
 @numba.njit(cache=True, nogil=True)
 def _bin_index(sample, shift, bins):
-    """Histogram bin of every pixel of an (h, w, 3) uint8 sample: its levels >> ``shift``."""
-    h, w = sample.shape[:2]
+    """
+    Histogram bin of every pixel of an (h, w, 3) uint8 sample: its levels >> ``shift``.
+
+    An (h, w, 1) sample's level counts for all three channels, as in the features' Colour Names.
+    """
+    h, w, c = sample.shape
     out = np.empty((h, w), np.intp)
     for y in range(h):
         for x in range(w):
             b0 = np.intp(sample[y, x, 0]) >> shift
-            b1 = np.intp(sample[y, x, 1]) >> shift
-            b2 = np.intp(sample[y, x, 2]) >> shift
+            b1 = np.intp(sample[y, x, 1 if c == 3 else 0]) >> shift
+            b2 = np.intp(sample[y, x, 2 if c == 3 else 0]) >> shift
             out[y, x] = (b0 * bins + b1) * bins + b2
     return out
 
