@@ -61,7 +61,9 @@ reference saved from an older tracker is seen as such.
 ``--resolution 0.5`` runs every tracker on the frames resized to half their width and height
 (OpenCV's area interpolation, as a camera binning its pixels) with the ground truth scaled alike:
 footage of lower resolution than the shared sequences, and smaller targets
-(docs/decisions.md#resolution-probe).
+(docs/decisions.md#resolution-probe).  ``--mono`` runs every tracker on one-channel grey frames
+(OpenCV's BGR-to-grey weights), as a monochrome camera's ``mono8`` images
+(docs/decisions.md#mono-camera).
 """
 from __future__ import annotations
 
@@ -128,9 +130,9 @@ def run(job):
 
     Decoded once.
     """
-    name, runs, shift, starts, resolution = job
+    name, runs, shift, starts, resolution, mono = job
     seq = load_sequence(name)
-    frames, truth = _resized(seq.frames(), seq.gt_boxes, resolution)
+    frames, truth = _resized(seq.frames(), seq.gt_boxes, resolution, mono)
     begins = []  # (first frame, box) of each start, the same for every tracker
     for dx, dy, scale, at in starts:
         k = start_frame(truth, at)
@@ -147,23 +149,27 @@ def run(job):
     return out
 
 
-def _resized(frames, boxes, factor: float) -> tuple[list, np.ndarray]:
+def _resized(frames, boxes, factor: float, mono: bool = False) -> tuple[list, np.ndarray]:
     """
     Return the decoded frames and 0-based ground-truth boxes at ``factor`` times their size.
 
-    Each frame is resized as it is decoded, so a sequence is never held at both sizes.  A box's
-    0-based corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
-    ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
+    Each frame is resized (and with ``mono`` turned to one-channel grey) as it is decoded, so a
+    sequence is never held twice.  A box's 0-based corner and size scale by the resized frame's
+    own ratio on each axis: pixel ``i`` spans ``[i - 1/2, i + 1/2]`` and the resize maps the
+    image's edges onto each other.
     """
     boxes = np.asarray(boxes, dtype=float)
-    if factor == 1.0:
-        return list(frames), boxes
-    resized = []
+    out, ratio = [], np.ones(2)
     for frame in frames:
-        h, w = frame.shape[:2]
-        size = (max(1, round(w * factor)), max(1, round(h * factor)))
-        resized.append(cv2.resize(frame, size, interpolation=cv2.INTER_AREA))
-    return resized, boxes * np.tile([size[0] / w, size[1] / h], 2)
+        if mono and frame.ndim == 3:
+            frame = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+        if factor != 1.0:
+            h, w = frame.shape[:2]
+            size = (max(1, round(w * factor)), max(1, round(h * factor)))
+            frame = cv2.resize(frame, size, interpolation=cv2.INTER_AREA)
+            ratio = np.array([size[0] / w, size[1] / h])
+        out.append(frame)
+    return out, boxes * np.tile(ratio, 2)
 
 
 def main() -> None:
@@ -200,6 +206,9 @@ def main() -> None:
         default=1.0,
         help='frames and ground truth resized by this factor, in (0, 1] (default: 1)',
     )
+    parser.add_argument(
+        '--mono', action='store_true', help='frames turned to one-channel grey (a mono camera)'
+    )
     parser.add_argument('--jobs', type=int, default=2)
     parser.add_argument(
         '--save', type=Path, help='write the average overlap of every run to this JSON file'
@@ -217,7 +226,9 @@ def main() -> None:
     reference = (
         None
         if args.against is None
-        else _load_reference(args.against, args.starts, args.shift, args.resolution, names)
+        else _load_reference(
+            args.against, args.starts, args.shift, args.resolution, args.mono, names
+        )
     )
     digest = _tracker_digest()
     # Checked here, before any run: a bad key or peer fails at once with its own message.
@@ -237,7 +248,7 @@ def main() -> None:
         results = pool.map(
             run,
             [
-                (name, runs, args.shift, START_SETS[args.starts], args.resolution)
+                (name, runs, args.shift, START_SETS[args.starts], args.resolution, args.mono)
                 for name in names
             ],
             chunksize=1,
@@ -253,6 +264,7 @@ def main() -> None:
     print(
         f'{len(names)} sequences x {n_starts} starts ({which})'
         + ('' if args.resolution == 1.0 else f', frames at {args.resolution:g} of their size')
+        + (', one-channel grey frames' if args.mono else '')
     )
     overlaps = {}
     first = runs[0][0]
@@ -290,6 +302,7 @@ def main() -> None:
                     'starts': args.starts,
                     'shift': args.shift,
                     'resolution': args.resolution,
+                    'mono': args.mono,
                     'tracker_sources': digest,
                     'saved': datetime.datetime.now().isoformat(timespec='seconds'),
                     'runs': {
@@ -324,27 +337,31 @@ def _tracker_digest() -> str:
 
 
 def _load_reference(
-    path: Path, starts: str, shift: float, resolution: float, names
+    path: Path, starts: str, shift: float, resolution: float, mono: bool, names
 ) -> tuple[str, np.ndarray, str]:
     """
     (label, AO % per sequence of ``names`` and start, source) of the first tracker saved by --save.
 
     Its source: the digest of the tracker sources it ran and when, as far as the file records them.
 
-    SystemExit with one line for a file that is not such a run, or one of other starts, shift or
-    resolution (a file without one is at full resolution), or without a run of one of ``names``.
+    SystemExit with one line for a file that is not such a run, or one of other starts, shift,
+    resolution or frames (a file without them is at full resolution, in the frames' own colour),
+    or without a run of one of ``names``.
     """
     try:
         saved = json.loads(path.read_text())
         label, runs = next(iter(saved['runs'].items()))
     except (OSError, ValueError, KeyError, StopIteration, AttributeError) as exc:
         raise SystemExit(f'--against {path}: not a run saved by --save ({exc})') from None
-    saved_as = (saved.get('starts'), saved.get('shift'), saved.get('resolution', 1.0))
-    if saved_as != (starts, shift, resolution):
+    saved_as = (
+        saved.get('starts'), saved.get('shift'), saved.get('resolution', 1.0),
+        saved.get('mono', False),
+    )
+    if saved_as != (starts, shift, resolution, mono):
         raise SystemExit(
             f'--against {path}: saved with --starts {saved_as[0]} --shift {saved_as[1]} '
-            f'--resolution {saved_as[2]}, this run uses --starts {starts} --shift {shift} '
-            f'--resolution {resolution}'
+            f'--resolution {saved_as[2]}{" --mono" * saved_as[3]}, this run uses --starts '
+            f'{starts} --shift {shift} --resolution {resolution}{" --mono" * mono}'
         )
     missing = [n for n in names if n not in runs]
     if missing:
