@@ -132,7 +132,7 @@ def run(job):
     """
     name, runs, shift, starts, resolution, mono = job
     seq = load_sequence(name)
-    frames, truth = _resized(seq.frames(), seq.gt_boxes, resolution, mono)
+    frames, truth = _as_camera(seq.frames(), seq.gt_boxes, resolution, mono)
     begins = []  # (first frame, box) of each start, the same for every tracker
     for dx, dy, scale, at in starts:
         k = start_frame(truth, at)
@@ -149,14 +149,15 @@ def run(job):
     return out
 
 
-def _resized(frames, boxes, factor: float, mono: bool = False) -> tuple[list, np.ndarray]:
+def _as_camera(frames, boxes, factor: float, mono: bool) -> tuple[list, np.ndarray]:
     """
-    Return the decoded frames and 0-based ground-truth boxes at ``factor`` times their size.
+    Return the decoded frames and 0-based ground-truth boxes as another camera would give them.
 
-    Each frame is resized (and with ``mono`` turned to one-channel grey) as it is decoded, so a
-    sequence is never held twice.  A box's 0-based corner and size scale by the resized frame's
-    own ratio on each axis: pixel ``i`` spans ``[i - 1/2, i + 1/2]`` and the resize maps the
-    image's edges onto each other.
+    That camera has ``factor`` times the frames' resolution and, with ``mono``, one grey channel.
+
+    Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
+    corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
+    ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
     """
     boxes = np.asarray(boxes, dtype=float)
     out, ratio = [], np.ones(2)
