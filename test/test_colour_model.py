@@ -132,8 +132,8 @@ def test_a_tracked_window_moves_toward_the_target_colours():
     A red square on a grey texture, the first box 6 px right of and below it; 30 frames of it.
 
     Without the colour model's share (``colour_merge`` 0) the translation filter keeps the first
-    box's offset; with the shipped share the window's centre moves toward the square's, ending with
-    at most 85 % of the offset (docs/decisions.md#colour-mean-shift).
+    box's offset; with the shipped share the window's centre moves toward the square's, ending
+    nearer than 0.85 times the first offset (docs/decisions.md#colour-mean-shift).
     """
     scene = np.repeat(texture(seed=3)[..., None], 3, axis=2)
     scene[40:80, 50:90] = RED
@@ -183,7 +183,7 @@ def test_pixel_scores_give_each_pixel_its_beta_and_keep_their_table():
     model.update(_scene(target=BLUE, box=box), box_centre(box), box[2:])
     np.testing.assert_array_equal(before(patch), [[1.0, 0.0, 0.0], [0.0, 1.0, 1.0]])
     np.testing.assert_allclose(model.pixel_scores()(patch), [[1.0, 0.0, 1.0], [1.0, 1.0, 1.0]])
-    # a grey patch is scored as the colours of three equal levels: here none is in either histogram
+    # a grey patch reads as the colours of three equal levels: here none is in either histogram
     grey = np.array([[0, 128, 255]], np.uint8)
     np.testing.assert_array_equal(before(grey), [[0.0, 0.0, 0.0]])
     np.testing.assert_array_equal(before(grey[..., None]), before(np.dstack([grey] * 3)))

@@ -167,10 +167,10 @@ def test_a_frame_is_scored_by_the_colour_model_as_it_was_at_the_estimate():
     The colour model learns on a worker thread while the filter learns from the same frame.
 
     Two filters learned alike, each with its colour model; between the estimate and the update on
-    the next frame (at a size 20 % larger, so the filter takes a new sample rather than shifting
+    the next frame (at 1.2 times the size, so the filter takes a new sample rather than shifting
     the estimate's), one model learns a frame all in the rectangle's red, which lowers red's beta
-    from 1 to 1 / 1.5.  Both filters learn the same filter: the new sample is scored as the model
-    was at the estimate.  Scored with the model after learning, its colour channel would differ.
+    from 1 to 1 / 1.5.  Both filters learn the same filter: the new sample takes beta from the
+    model as it was at the estimate.  With the model after learning its colour channel differs.
     """
     from iemd_ros.tracking.colour_model import ColourModel
 

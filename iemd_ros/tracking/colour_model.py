@@ -287,9 +287,9 @@ class ColourModel:
         """
         Return Staple's per-pixel score beta as the histograms are now, as a function of a patch.
 
-        The function maps an (H, W, 3) uint8 BGR patch to its (H, W) float32 beta, each pixel
-        scored by its colour bin; a grey patch, (H, W) or (H, W, 1) (a grey frame in a colour
-        stream), is scored as the colours of three equal levels.  It keeps the table it was made
+        The function maps an (H, W, 3) uint8 BGR patch to its (H, W) float32 beta, each pixel's
+        from its colour bin; a grey patch, (H, W) or (H, W, 1) (a grey frame in a colour stream),
+        reads as the colours of three equal levels.  It keeps the table it was made
         with, so a later :meth:`update` does not change it: a model learning on another thread
         cannot change a sample half-way.  Until then every call returns the same function.
 

@@ -152,8 +152,8 @@ class TranslationFilter:
         w, h = max(float(size[0]), 1.0), max(float(size[1]), 1.0)
         self.colour = bool(colour)
         self.colour_model = colour_model
-        # the colour model's per-pixel score as it was at the last estimate (or at init): the
-        # samples of one frame are scored alike while the model learns on another thread
+        # the colour model's per-pixel score as it was at the last estimate (or at init): one
+        # frame's samples read the same beta while the model learns on another thread
         self._scores = None if colour_model is None else colour_model.pixel_scores()
         area = w * h * SEARCH_AREA_SCALE ** 2
         s0 = np.sqrt(area / np.clip(area, *SAMPLE_AREA))
@@ -228,8 +228,8 @@ class TranslationFilter:
         Displacement (dx, dy) px from the region's window centre to where the response peaks.
 
         The response is kept for :meth:`response_at`, its peak value in :attr:`response_peak`.
-        With a colour model, the region's colour channel is added here, scored by the model as it
-        is now: call it when the model is not learning.
+        With a colour model, the region's colour channel is added here, from the model as it is
+        now: call it when the model is not learning.
 
         Parameters
         ----------
