@@ -189,8 +189,7 @@ class ColourModel:
             Before :meth:`init`.
 
         """
-        if not self.trained:
-            raise RuntimeError('ColourModel.estimate() called before init()')
+        self._require_trained('estimate')
         size = np.asarray(size, dtype=np.float64)
         region = 2.0 * size + 2.0 * self.padding * np.sqrt(size[0] * size[1])
         bins, scale = self._bin_indices(frame, center, region, angle)
@@ -269,8 +268,7 @@ class ColourModel:
             Before :meth:`init`.
 
         """
-        if not self.trained:
-            raise RuntimeError('ColourModel.mean_shift() called before init()')
+        self._require_trained('mean_shift')
         bins, scale = self._bin_indices(frame, center, np.asarray(size, dtype=np.float64), angle)
         beta = self._beta[bins]
         total = float(beta.sum())
@@ -304,8 +302,7 @@ class ColourModel:
             Before :meth:`init`.
 
         """
-        if not self.trained:
-            raise RuntimeError('ColourModel.pixel_scores() called before init()')
+        self._require_trained('pixel_scores')
         if self._scores is None:
             table, shift, bins = self._beta.astype(np.float32), self._shift, self.bins
 
@@ -315,6 +312,11 @@ class ColourModel:
 
             self._scores = scores
         return self._scores
+
+    def _require_trained(self, method: str) -> None:
+        """Raise RuntimeError naming ``method`` when :meth:`init` has not learnt the histograms."""
+        if not self.trained:
+            raise RuntimeError(f'ColourModel.{method}() called before init()')
 
     def _histograms(self, frame, center, size, angle):
         """
