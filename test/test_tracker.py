@@ -50,9 +50,11 @@ from iemd_ros.tracking.tracker import (
     Cause,
     CONFIDENT_APCE,
     CONFIDENT_PEAK,
+    FRAME_SEARCH_AFTER,
     MIN_SIDE_PX,
     REDETECT_SIZES,
 )
+from iemd_ros.tracking.translation_filter import TranslationFilter
 import numpy as np
 import pytest
 
@@ -632,6 +634,51 @@ def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, mon
     assert sum(not (r.lost or r.held) for r in serial) >= 20  # most frames learned
     assert [r.box for r in threaded] == [r.box for r in serial]
     assert [r.emd for r in threaded] == [r.emd for r in serial]
+
+
+def test_a_lost_frames_re_detection_samples_on_a_worker_as_the_serial_schedule(
+    uav_root, monkeypatch
+):
+    """
+    boat5 frames 1-65, lost from frame 50: re-detection gives the results of ``threads=False``.
+
+    With threads every re-detection region (around where the target was lost, at the whole-frame
+    strip's peak) is sampled on a worker thread, and the strip on the lost frames after the first
+    FRAME_SEARCH_AFTER.
+    """
+    seq = load_sequence(uav_root / 'boat5')
+    frames = [read_frame(p) for p in seq.frame_paths[:65]]
+    threads = {'sample': [], 'frame_strip': []}
+    for name, calls in threads.items():
+        method = getattr(TranslationFilter, name)
+
+        def record(self, *args, method=method, calls=calls):
+            calls.append(threading.current_thread().name)
+            return method(self, *args)
+
+        monkeypatch.setattr(TranslationFilter, name, record)
+
+    def run(threaded):
+        for calls in threads.values():
+            calls.clear()
+        tracker = IemdTracker(threads=threaded)
+        tracker.init(frames[0], seq.gt_boxes[0])
+        return [tracker.update(frame) for frame in frames[1:]]
+
+    threaded = run(True)
+    on_workers = {
+        name: sum(t.startswith('iemd-tracker') for t in calls) for name, calls in threads.items()
+    }
+    serial = run(False)
+    lost = sum(r.lost for r in serial)
+    assert lost >= FRAME_SEARCH_AFTER + 5
+    assert 0 < on_workers['frame_strip'] <= lost - FRAME_SEARCH_AFTER
+    # each strip's peak, and the place the target was lost
+    assert on_workers['sample'] > on_workers['frame_strip']
+    assert [r.box for r in threaded] == [r.box for r in serial]
+    assert [(r.lost, r.cause, r.emd) for r in threaded] == [
+        (r.lost, r.cause, r.emd) for r in serial
+    ]
 
 
 def test_update_returns_before_the_models_learn_and_the_next_call_waits_for_them(monkeypatch):

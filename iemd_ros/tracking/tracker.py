@@ -318,6 +318,8 @@ class IemdTracker:
             angle = _wrap_angle(angle + turn)
             anchor = None if anchor is None else _apply_prior(prior, anchor, size)[0]
         cfg = self.config
+        # a lost frame's re-detection regions are sampled on a worker beside the local search
+        samples = self._redetection_samples(frame, anchor, size, angle) if self._lost else None
         # what needs no model (grey levels, pyramid, the filter's sample) runs while the models
         # still learn from the last frame
         grey, pyramid = self._take_frame(frame)
@@ -346,7 +348,7 @@ class IemdTracker:
         # the prior moved the window out of view: keep its place, search only the frame
         if not in_view:
             redetected = (
-                self._redetect(frame, pyramid, size, angle, predicted, 0, 0)
+                self._redetect(frame, pyramid, size, angle, predicted, 0, 0, samples)
                 if self._lost
                 else None
             )
@@ -382,7 +384,9 @@ class IemdTracker:
                 cfg.found_response if self._lost else cfg.lost_response
             )
         if cause is not None and self._lost:
-            redetected = self._redetect(frame, pyramid, size, angle, predicted, starts, codings)
+            redetected = self._redetect(
+                frame, pyramid, size, angle, predicted, starts, codings, samples
+            )
             if redetected is not None:
                 return redetected
         # the window follows the local search (not out of the image), without learning
@@ -400,6 +404,8 @@ class IemdTracker:
                 starts=starts,
                 codings=codings,
             )
+        if samples is not None:  # found by the local search: the caller may reuse the frame next
+            samples.result()
         self._lost, self._lost_frames, self._anchor = False, 0, None
         held = bool(best.held_reason)
         self._center, self._size, self._angle = new_center, new_size, angle
@@ -499,7 +505,7 @@ class IemdTracker:
         )
 
     def _redetect(
-        self, frame, pyramid, size, angle, predicted, starts: int, codings: int
+        self, frame, pyramid, size, angle, predicted, starts: int, codings: int, samples
     ) -> TrackResult | None:
         """
         Re-detect the target on a lost frame the local search did not confirm.
@@ -515,25 +521,23 @@ class IemdTracker:
         lost size unless its EMD is lower at the other (the paper's scale rule, section 6.1).  The
         result when the best peak reaches the level of :func:`_found_level` and its window's EMD
         is below the lost limit, else None.  Nothing learns from the frame; its best peak at the
-        lost size joins the loss's background peaks.
+        lost size joins the loss's background peaks.  ``samples`` is
+        :meth:`_redetection_samples`'s Future, or None.
         """
-        tf, cfg = self._translation_filter, self.config
-        # no frame learned yet: no response to compare a candidate with
-        if tf is None or self._confidence is None:
+        if samples is None:  # no frame learned yet: no response to compare a candidate with
             return None
+        tf, cfg = self._translation_filter, self.config
         wanted, level = _found_level(
             self._confidence, self._background_peaks, cfg.found_response, cfg.lost_response
         )
+        near, scanned = samples.result()
         candidates = []  # (centre, filter peak there, where its region was centred)
-        if _visible_fraction(self._anchor, size, angle, frame.shape) >= cfg.min_visible:
-            at = self._anchor
-            candidates.append(self._filter_peak(frame, at, size, angle) + (at,))
-        if self._lost_frames >= FRAME_SEARCH_AFTER and not (
-            candidates and candidates[0][1] >= wanted
-        ):
-            coarse, _, parts = tf.search_frame(frame, size, self._search_part)
+        if near is not None:
+            candidates.append(self._region_peak(near) + (near.center,))
+        if scanned is not None and not (candidates and candidates[0][1] >= wanted):
+            region, parts = scanned
             self._search_part = (self._search_part + 1) % parts
-            candidates.append(self._filter_peak(frame, coarse, size, angle) + (coarse,))
+            candidates.append(self._region_peak(region) + (region.center,))
         found, peak, at = max(candidates, key=lambda c: c[1], default=(None, -np.inf, None))
         other, searched = None, len(candidates)
         # a peak off its region's centre is weakened by the cosine window: measured centred on it
@@ -586,10 +590,41 @@ class IemdTracker:
             ),
         )
 
+    def _redetection_samples(self, frame, anchor, size, angle):
+        """
+        Return a Future of the regions :meth:`_redetect` searches on this lost frame.
+
+        (The translation filter's region around ``anchor`` where enough of it is in view, else
+        None; lost for ``FRAME_SEARCH_AFTER`` frames, (the region around the filter's peak over
+        the frame's next strip, how many strips the frame has), else None.)  None without the
+        filter or before any frame learned.  They are sampled on a worker while the local search
+        runs: sampling reads no model, and the strip's response reads models that do not learn
+        while the target is lost.
+        """
+        tf, cfg = self._translation_filter, self.config
+        if tf is None or self._confidence is None:
+            return None
+        in_view = _visible_fraction(anchor, size, angle, frame.shape) >= cfg.min_visible
+        scan = self._lost_frames >= FRAME_SEARCH_AFTER
+        part = self._search_part
+
+        def sample():
+            near = tf.sample(frame, anchor, size, angle) if in_view else None
+            if not scan:
+                return near, None
+            coarse, _, parts = tf.search_frame(tf.frame_strip(frame, size, part))
+            return near, (tf.sample(frame, coarse, size, angle), parts)
+
+        return self._workers.submit(sample)
+
     def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float]:
         """(centre, value) of the translation filter's peak in its search region around ``at``."""
+        return self._region_peak(self._translation_filter.sample(frame, at, size, angle))
+
+    def _region_peak(self, region) -> tuple[np.ndarray, float]:
+        """(centre, value) of the translation filter's peak in a sampled search ``region``."""
         tf = self._translation_filter
-        return at + tf.estimate(tf.sample(frame, at, size, angle)), tf.response_peak
+        return region.center + tf.estimate(region), tf.response_peak
 
     def _filter_confident(self) -> bool:
         """

@@ -80,7 +80,7 @@ import numba
 import numpy as np
 import scipy.fft as sfft
 
-__all__ = ['Region', 'TranslationFilter', 'SEARCH_AREA_SCALE']
+__all__ = ['Region', 'Strip', 'TranslationFilter', 'SEARCH_AREA_SCALE']
 
 SEARCH_AREA_SCALE = 5.0                       # side of the search region / sqrt(w h) (STRCF, BACF)
 CN_WEIGHT = 2.0                               # Colour Names channels' weight; fHOG's, grey's 1
@@ -103,6 +103,19 @@ class Region(NamedTuple):
     angle: float         # the region's turn, radians
     zf: np.ndarray       # (C, n, n // 2 + 1) spectrum of the windowed features
     patch: np.ndarray | None  # the resampled region, kept for the colour channel (else None)
+
+
+class Strip(NamedTuple):
+    """A vertical strip of a frame at a window's scale (:meth:`TranslationFilter.frame_strip`)."""
+
+    patch: np.ndarray    # the strip with its margins, resampled to the filter's scale
+    features: np.ndarray  # (C, rows, cols) its feature channels, without the colour channel
+    lo: int              # the frame's cell column of the patch's first column
+    first: int           # the frame's cell column of the strip's first column
+    width: int           # the strip's own columns (the last strip may have fewer in the frame)
+    cells: tuple         # the frame's (rows, cols) cells at this scale
+    cell_px: np.ndarray  # (x, y) size of a cell in frame pixels
+    parts: int           # how many strips the frame has at this scale
 
 
 class TranslationFilter:
@@ -273,20 +286,17 @@ class TranslationFilter:
         d = axes.T @ (np.asarray(point, dtype=np.float64) - pos) / cell_px
         return _bilinear_circular(resp, float(d[1]), float(d[0]))
 
-    def search_frame(
-        self, frame: np.ndarray, size, part: int = 0
-    ) -> tuple[np.ndarray, float, int]:
+    def search_frame(self, strip: Strip) -> tuple[np.ndarray, float, int]:
         """
-        Where in one part of ``frame`` the filter responds most.
+        Where in one strip of a frame the filter responds most.
 
-        The filter is taken at the scale of a window of ``size``; the response is
-        :meth:`frame_response`'s.  A caller scans the whole frame by asking for parts 0, 1, ...
-        over several frames.
+        The response is :meth:`frame_response`'s.  A caller scans the whole frame by asking for
+        parts 0, 1, ... of :meth:`frame_strip` over several frames.
 
         Parameters
         ----------
-        frame, size, part
-            As in :meth:`frame_response`.
+        strip : Strip
+            :meth:`frame_strip` of the frame.
 
         Returns
         -------
@@ -299,24 +309,19 @@ class TranslationFilter:
             How many strips the frame has at this scale.
 
         """
-        resp, first, cell_px, parts = self.frame_response(frame, size, part)
+        resp, first, cell_px, parts = self.frame_response(strip)
         k = np.unravel_index(int(np.argmax(resp)), resp.shape)
         centre = (np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5) * cell_px - 0.5
         return centre, float(resp[k]), parts
 
-    def frame_response(
-        self, frame: np.ndarray, size, part: int = 0
-    ) -> tuple[np.ndarray, int, np.ndarray, int]:
+    def frame_strip(self, frame: np.ndarray, size, part: int = 0) -> Strip:
         """
-        Return the filter's response over one vertical strip of ``frame`` at the scale of ``size``.
+        Return one vertical strip of ``frame`` at the scale of ``size`` (:meth:`frame_response`).
 
         The frame is resampled to the filter's scale and cut into vertical strips of at most
-        ``FRAME_SEARCH_CELLS`` feature cells.  The strip's features are correlated with the spatial
-        filter cropped to the target's cells (:attr:`target_cells`: the regularization leaves it
-        all but zero outside them, BACF's crop), read with the margins the crop needs, and
-        zero-padded so that the response is linear, not circular, over the strip's own cells:
-        by the crop's size down the frame and beyond the strip's own width (overlap-save: the
-        margins wrap only into cells not returned).
+        ``FRAME_SEARCH_CELLS`` feature cells; the strip is read with the margins the filter's crop
+        to the target's cells needs.  It reads only the geometry fixed by :meth:`init`, not the
+        filter, so it may run while the filter estimates elsewhere.
 
         Parameters
         ----------
@@ -326,6 +331,48 @@ class TranslationFilter:
             The window's size (w, h), px: the scale the frame is resampled to.
         part : int
             Which strip (taken modulo the number of strips).
+
+        Returns
+        -------
+        Strip
+            The strip's features and where it lies in the frame.
+
+        """
+        rows, cols = frame.shape[:2]
+        cell = self.cell_size(size)
+        cells = (max(int(rows / cell), 1), max(int(cols / cell), 1))
+        parts = max(int(np.ceil(cells[0] * cells[1] / FRAME_SEARCH_CELLS)), 1)
+        width = int(np.ceil(cells[1] / parts))
+        parts = int(np.ceil(cells[1] / width))  # no empty last strip
+        crop, origin = self._frame_crop()
+        first = (part % parts) * width
+        lo, hi = max(first - origin[1], 0), min(first + width + crop[1] - 1 - origin[1], cells[1])
+        cell_px = np.array([cols / cells[1], rows / cells[0]])
+        patch = sample_region(
+            frame,
+            ((lo + hi) / 2 * cell_px[0] - 0.5, rows / 2 - 0.5),
+            ((hi - lo) * cell_px[0], rows),
+            ((hi - lo) * features.CELL, cells[0] * features.CELL),
+        )
+        return Strip(
+            patch, features.extract(patch, self.colour), lo, first, width, cells, cell_px, parts
+        )
+
+    def frame_response(self, strip: Strip) -> tuple[np.ndarray, int, np.ndarray, int]:
+        """
+        Return the filter's response over one strip of a frame.
+
+        The strip's features, with the colour channel from the colour model as it is now, are
+        correlated with the spatial filter cropped to the target's cells (:attr:`target_cells`:
+        the regularization leaves it all but zero outside them, BACF's crop), zero-padded so that
+        the response is linear, not circular, over the strip's own cells: by the crop's size down
+        the frame and beyond the strip's own width (overlap-save: the margins wrap only into cells
+        not returned).
+
+        Parameters
+        ----------
+        strip : Strip
+            :meth:`frame_strip` of the frame.
 
         Returns
         -------
@@ -341,31 +388,12 @@ class TranslationFilter:
             How many strips the frame has at this scale.
 
         """
-        rows, cols = frame.shape[:2]
-        cell = self.cell_size(size)
-        cells = (max(int(rows / cell), 1), max(int(cols / cell), 1))
-        parts = max(int(np.ceil(cells[0] * cells[1] / FRAME_SEARCH_CELLS)), 1)
-        width = int(np.ceil(cells[1] / parts))
-        parts = int(np.ceil(cells[1] / width))  # no empty last strip
-        # the crop's size and where in it the target's centre is: a target at cell k answers
-        # at displacement k - origin
-        ty, tx = self.target_cells
-        crop = (ty.stop - ty.start, tx.stop - tx.start)
-        origin = (self.map_hw[0] // 2 - ty.start, self.map_hw[1] // 2 - tx.start)
-        first = (part % parts) * width
-        lo, hi = max(first - origin[1], 0), min(first + width + crop[1] - 1 - origin[1], cells[1])
-        cell_px = np.array([cols / cells[1], rows / cells[0]])
-        strip = sample_region(
-            frame,
-            ((lo + hi) / 2 * cell_px[0] - 0.5, rows / 2 - 0.5),
-            ((hi - lo) * cell_px[0], rows),
-            ((hi - lo) * features.CELL, cells[0] * features.CELL),
-        )
-        z = self._features(strip)
-        z *= self.channel_weight[:, None, None]
+        z = self._with_colour(strip.features, strip.patch) * self.channel_weight[:, None, None]
+        crop, origin = self._frame_crop()
+        cells, first, lo = strip.cells, strip.first, strip.lo
         # sizes the FFT factors well
         shape = tuple(
-            sfft.next_fast_len(k + c - 1, real=True) for k, c in zip((cells[0], width), crop)
+            sfft.next_fast_len(k + c - 1, real=True) for k, c in zip((cells[0], strip.width), crop)
         )
         if (
             self._frame_filter is None
@@ -376,9 +404,19 @@ class TranslationFilter:
             self._frame_filter = (self.f, shape, np.conj(sfft.rfft2(h, s=shape, axes=(1, 2))))
         resp_f = np.sum(self._frame_filter[2] * sfft.rfft2(z, s=shape, axes=(1, 2)), axis=0)
         resp = np.roll(sfft.irfft2(resp_f, s=shape), origin, axis=(0, 1))[
-            :cells[0], first - lo:min(first + width, cells[1]) - lo
+            :cells[0], first - lo:min(first + strip.width, cells[1]) - lo
         ]
-        return resp, first, cell_px, parts
+        return resp, first, strip.cell_px, strip.parts
+
+    def _frame_crop(self) -> tuple[tuple[int, int], tuple[int, int]]:
+        """
+        (rows, cols) of the filter's crop to the target's cells, and where the target's centre is.
+
+        A target at cell k of a strip answers at displacement k - origin.
+        """
+        ty, tx = self.target_cells
+        crop = (ty.stop - ty.start, tx.stop - tx.start)
+        return crop, (self.map_hw[0] // 2 - ty.start, self.map_hw[1] // 2 - tx.start)
 
     @property
     def confidence(self) -> dict:
@@ -526,7 +564,10 @@ class TranslationFilter:
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
         """Return every feature channel of ``patch`` (:func:`features.extract`, the colour's)."""
-        x = features.extract(patch, self.colour)
+        return self._with_colour(features.extract(patch, self.colour), patch)
+
+    def _with_colour(self, x: np.ndarray, patch: np.ndarray) -> np.ndarray:
+        """Return the channels ``x`` of ``patch`` and, with a colour model, its colour channel."""
         if self.colour_model is None:
             return x
         return np.concatenate([x, self._colour_channel(patch)[None]])
