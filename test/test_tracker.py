@@ -636,19 +636,20 @@ def test_the_models_on_worker_threads_track_as_the_serial_schedule(otb_root, mon
     assert [r.emd for r in threaded] == [r.emd for r in serial]
 
 
-def test_a_lost_frames_re_detection_samples_on_a_worker_as_the_serial_schedule(
+def test_a_lost_frames_re_detection_searches_on_a_worker_as_the_serial_schedule(
     uav_root, monkeypatch
 ):
     """
     boat5 frames 1-65, lost from frame 50: re-detection gives the results of ``threads=False``.
 
-    With threads every re-detection region (around where the target was lost, at the whole-frame
-    strip's peak) is sampled on a worker thread, and the strip on the lost frames after the first
+    With threads the caller samples only each frame's own search region; every re-detection region
+    (where the target was lost, at the whole-frame strip's peak, centred again, at another size)
+    is sampled and searched on a worker thread, and the strip on the lost frames after the first
     FRAME_SEARCH_AFTER.
     """
     seq = load_sequence(uav_root / 'boat5')
     frames = [read_frame(p) for p in seq.frame_paths[:65]]
-    threads = {'sample': [], 'frame_strip': []}
+    threads = {'sample': [], 'locate': [], 'frame_strip': []}
     for name, calls in threads.items():
         method = getattr(TranslationFilter, name)
 
@@ -669,15 +670,18 @@ def test_a_lost_frames_re_detection_samples_on_a_worker_as_the_serial_schedule(
     on_workers = {
         name: sum(t.startswith('iemd-tracker') for t in calls) for name, calls in threads.items()
     }
+    in_caller = {name: len(calls) - on_workers[name] for name, calls in threads.items()}
     serial = run(False)
     lost = sum(r.lost for r in serial)
     assert lost >= FRAME_SEARCH_AFTER + 5
     assert 0 < on_workers['frame_strip'] <= lost - FRAME_SEARCH_AFTER
-    # each strip's peak, and the place the target was lost
-    assert on_workers['sample'] > on_workers['frame_strip']
+    # each lost frame after the first: where the target was lost; each strip: its peak
+    assert on_workers['sample'] >= lost - 1 + on_workers['frame_strip']
+    assert on_workers['locate'] == on_workers['sample']
+    assert in_caller == {'sample': len(frames) - 1, 'locate': 0, 'frame_strip': 0}
     assert [r.box for r in threaded] == [r.box for r in serial]
-    assert [(r.lost, r.cause, r.emd) for r in threaded] == [
-        (r.lost, r.cause, r.emd) for r in serial
+    assert [(r.lost, r.cause, r.emd, r.starts) for r in threaded] == [
+        (r.lost, r.cause, r.emd, r.starts) for r in serial
     ]
 
 

@@ -193,9 +193,8 @@ def test_a_frame_is_scored_by_the_colour_model_as_it_was_at_the_estimate():
         filters.append(tf.f)
     np.testing.assert_array_equal(filters[0], filters[1])
     patch = tf._patch(moved, np.round(at), tf._scale(size * 1.2), 0.0)
-    at_estimate = tf._colour_channel(patch)
-    tf._scores = model.pixel_scores()
-    assert not np.allclose(tf._colour_channel(patch), at_estimate, atol=0.05)
+    at_estimate = tf._colour_channel(patch, tf._scores)
+    assert not np.allclose(tf._colour_channel(patch, model.pixel_scores()), at_estimate, atol=0.05)
 
 
 def test_a_grey_frame_in_a_colour_stream_is_tracked_with_the_colour_channel():

@@ -49,6 +49,7 @@ their own.
 from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
+import dataclasses
 from dataclasses import dataclass
 import enum
 import functools
@@ -135,6 +136,20 @@ class TrackResult:
     # tracked, but the models did not learn and the size was kept (occlusion check)
     held: bool = False
     cause: Cause | None = None  # the reason's kind (None: tracked and learned)
+
+
+@dataclass
+class _Found:
+    """What re-detection found on a lost frame (:meth:`IemdTracker._redetection_search`)."""
+
+    wanted: float  # the peak a re-detection needs (_found_level)
+    level: str  # how that level was set, for the reason
+    centre: np.ndarray | None = None  # the best peak's window centre
+    peak: float = -np.inf  # the filter's response there
+    searched: int = 0  # regions searched
+    parts: int = 0  # the frame's strip count when a strip was searched, else 0
+    background: float = 0.0  # the best peak at the lost size: one of the loss's background peaks
+    other: np.ndarray | None = None  # the other size searched, if one was
 
 
 @dataclass
@@ -318,8 +333,8 @@ class IemdTracker:
             angle = _wrap_angle(angle + turn)
             anchor = None if anchor is None else _apply_prior(prior, anchor, size)[0]
         cfg = self.config
-        # a lost frame's re-detection regions are sampled on a worker beside the local search
-        samples = self._redetection_samples(frame, anchor, size, angle) if self._lost else None
+        # a lost frame's re-detection searches on a worker beside the local search
+        search = self._redetection_search(frame, anchor, size, angle) if self._lost else None
         # what needs no model (grey levels, pyramid, the filter's sample) runs while the models
         # still learn from the last frame
         grey, pyramid = self._take_frame(frame)
@@ -348,7 +363,7 @@ class IemdTracker:
         # the prior moved the window out of view: keep its place, search only the frame
         if not in_view:
             redetected = (
-                self._redetect(frame, pyramid, size, angle, predicted, 0, 0, samples)
+                self._redetect(frame, pyramid, size, angle, predicted, 0, 0, search)
                 if self._lost
                 else None
             )
@@ -385,7 +400,7 @@ class IemdTracker:
             )
         if cause is not None and self._lost:
             redetected = self._redetect(
-                frame, pyramid, size, angle, predicted, starts, codings, samples
+                frame, pyramid, size, angle, predicted, starts, codings, search
             )
             if redetected is not None:
                 return redetected
@@ -404,8 +419,8 @@ class IemdTracker:
                 starts=starts,
                 codings=codings,
             )
-        if samples is not None:  # found by the local search: the caller may reuse the frame next
-            samples.result()
+        if search is not None:  # found by the local search: the caller may reuse the frame next
+            search.result()
         self._lost, self._lost_frames, self._anchor = False, 0, None
         held = bool(best.held_reason)
         self._center, self._size, self._angle = new_center, new_size, angle
@@ -505,69 +520,39 @@ class IemdTracker:
         )
 
     def _redetect(
-        self, frame, pyramid, size, angle, predicted, starts: int, codings: int, samples
+        self, frame, pyramid, size, angle, predicted, starts: int, codings: int, search
     ) -> TrackResult | None:
         """
         Re-detect the target on a lost frame the local search did not confirm.
 
-        The filter searches where the target was lost (that place moved by the priors since), then,
-        lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near where it
-        happened), one strip of the whole frame (the frame is scanned over lost frames) refined by
-        a search at its peak.  Where no peak reaches ``found_response`` times the running mean,
-        the highest, if more than a cell from the centre of the region it was found in, is
-        measured again in a region centred on it (the cosine window weakens a peak off the
-        centre); then, still short, the filter searches its place at one other size of
-        ``REDETECT_SIZES`` (a target may come back nearer or farther); a window found so keeps the
-        lost size unless its EMD is lower at the other (the paper's scale rule, section 6.1).  The
-        result when the best peak reaches the level of :func:`_found_level` and its window's EMD
-        is below the lost limit, else None.  Nothing learns from the frame; its best peak at the
-        lost size joins the loss's background peaks.  ``samples`` is
-        :meth:`_redetection_samples`'s Future, or None.
+        ``search`` is :meth:`_redetection_search`'s Future (None: no frame learned yet, no response
+        to compare a candidate with).  The result when the best peak it found reaches the level of
+        :func:`_found_level` and its window's EMD is below the lost limit, else None; a window
+        found at another size keeps the lost size unless its EMD is lower at the other (the
+        paper's scale rule, section 6.1).  Nothing learns from the frame; its best peak at the
+        lost size joins the loss's background peaks.
         """
-        if samples is None:  # no frame learned yet: no response to compare a candidate with
+        if search is None:
             return None
-        tf, cfg = self._translation_filter, self.config
-        wanted, level = _found_level(
-            self._confidence, self._background_peaks, cfg.found_response, cfg.lost_response
-        )
-        near, scanned = samples.result()
-        candidates = []  # (centre, filter peak there, where its region was centred)
-        if near is not None:
-            candidates.append(self._region_peak(near) + (near.center,))
-        if scanned is not None and not (candidates and candidates[0][1] >= wanted):
-            region, parts = scanned
-            self._search_part = (self._search_part + 1) % parts
-            candidates.append(self._region_peak(region) + (region.center,))
-        found, peak, at = max(candidates, key=lambda c: c[1], default=(None, -np.inf, None))
-        other, searched = None, len(candidates)
-        # a peak off its region's centre is weakened by the cosine window: measured centred on it
-        if peak < wanted and candidates and np.hypot(*(found - at)) > tf.cell_size(size):
-            found, peak = self._filter_peak(frame, found, size, angle)
-            searched += 1
-        if candidates:
+        found = search.result()
+        if found.parts:
+            self._search_part = (self._search_part + 1) % found.parts
+        if found.searched:
+            peak = found.background
             self._background_peaks += (1.0, peak, peak * peak)
-        factor = _redetect_factor(self._lost_frames, size, frame.shape) if peak < wanted else 1.0
-        if candidates and factor != 1.0:
-            other = size * factor
-            peaks = (
-                [self._filter_peak(frame, found, other, angle)]
-                if _visible_fraction(found, other, angle, frame.shape) >= cfg.min_visible
-                else []
-            )
-            searched += len(peaks)
-            found, peak = max(peaks, key=lambda c: c[1], default=(None, -np.inf))
-        if peak < wanted:
+        if found.peak < found.wanted:
             return None
-        model = CandidateModel(self._context(pyramid, angle), found, size)
+        centre, other = found.centre, found.other
+        model = CandidateModel(self._context(pyramid, angle), centre, size)
         emd, resized = model.emd()[0], False
         if other is not None:  # the scale variant at the same centre
-            emd_other = model.at(found, other).emd()[0]
+            emd_other = model.at(centre, other).emd()[0]
             if emd_other < emd:
                 emd, size, resized = emd_other, other, True
-        if self._lost_reason(emd, found, size, angle, frame.shape)[0] is not None:
+        if self._lost_reason(emd, centre, size, angle, frame.shape)[0] is not None:
             return None
         self._center, self._size, self._angle, self._lost, self._lost_frames = (
-            found,
+            centre,
             size,
             angle,
             False,
@@ -575,56 +560,78 @@ class IemdTracker:
         )
         self._anchor = None
         return TrackResult(
-            box=_box(found, size, angle),
+            box=_box(centre, size, angle),
             emd=emd,
             iterations=0,
             lost=False,
             angle=angle,
-            starts=starts + searched,
+            starts=starts + found.searched,
             codings=codings + (1 if other is None else 2),
             predicted_box=predicted,
             cause=Cause.REDETECTED,
             reason=(
-                f're-detected: filter peak {peak:.3f} >= {level}'
+                f're-detected: filter peak {found.peak:.3f} >= {found.level}'
                 + (f', at {size[0]:.0f}x{size[1]:.0f} px (another size)' if resized else '')
             ),
         )
 
-    def _redetection_samples(self, frame, anchor, size, angle):
+    def _redetection_search(self, frame, anchor, size, angle):
         """
-        Return a Future of the regions :meth:`_redetect` searches on this lost frame.
+        Return a Future of where the translation filter finds the target on this lost frame.
 
-        (The translation filter's region around ``anchor`` where enough of it is in view, else
-        None; lost for ``FRAME_SEARCH_AFTER`` frames, (the region around the filter's peak over
-        the frame's next strip, how many strips the frame has), else None.)  None without the
-        filter or before any frame learned.  They are sampled on a worker while the local search
-        runs: sampling reads no model, and the strip's response reads models that do not learn
-        while the target is lost.
+        The filter searches where the target was lost (``anchor``: that place moved by the priors
+        since), then, lost for ``FRAME_SEARCH_AFTER`` frames (a short loss is found again near
+        where it happened), one strip of the whole frame (the frame is scanned over lost frames)
+        refined by a search at its peak.  Where no peak reaches the level of :func:`_found_level`,
+        the highest, if more than a cell from the centre of the region it was found in, is
+        measured again in a region centred on it (the cosine window weakens a peak off the
+        centre); then, still short, the filter searches its place at one other size of
+        ``REDETECT_SIZES`` (a target may come back nearer or farther).  None without the filter or
+        before any frame learned.  The search runs on a worker beside the local search: it keeps
+        nothing, and the models it reads do not learn while the target is lost.
         """
         tf, cfg = self._translation_filter, self.config
         if tf is None or self._confidence is None:
             return None
+        wanted, level = _found_level(
+            self._confidence, self._background_peaks, cfg.found_response, cfg.lost_response
+        )
         in_view = _visible_fraction(anchor, size, angle, frame.shape) >= cfg.min_visible
         scan = self._lost_frames >= FRAME_SEARCH_AFTER
-        part = self._search_part
+        part, factor = self._search_part, _redetect_factor(self._lost_frames, size, frame.shape)
 
-        def sample():
-            near = tf.sample(frame, anchor, size, angle) if in_view else None
-            if not scan:
-                return near, None
-            coarse, _, parts = tf.search_frame(tf.frame_strip(frame, size, part))
-            return near, (tf.sample(frame, coarse, size, angle), parts)
+        def peak_at(at, window) -> tuple[np.ndarray, float]:
+            region = tf.sample(frame, at, window, angle)
+            move, value = tf.locate(region)
+            return region.center + move, value
 
-        return self._workers.submit(sample)
+        def search() -> _Found:
+            candidates = []  # (centre, filter peak there, where its region was centred)
+            parts = 0
+            if in_view:
+                candidates.append(peak_at(anchor, size) + (anchor,))
+            if scan and not (candidates and candidates[0][1] >= wanted):
+                coarse, _, parts = tf.search_frame(tf.frame_strip(frame, size, part))
+                candidates.append(peak_at(coarse, size) + (coarse,))
+            if not candidates:
+                return _Found(wanted, level)
+            (centre, peak, at), searched = max(candidates, key=lambda c: c[1]), len(candidates)
+            # a peak off its region's centre is weakened by the cosine window: measured on it
+            if peak < wanted and np.hypot(*(centre - at)) > tf.cell_size(size):
+                centre, peak = peak_at(centre, size)
+                searched += 1
+            found = _Found(wanted, level, centre, peak, searched, parts, background=peak)
+            if peak >= wanted or factor == 1.0:
+                return found
+            other = size * factor
+            if _visible_fraction(centre, other, angle, frame.shape) < cfg.min_visible:
+                return dataclasses.replace(found, centre=None, peak=-np.inf, other=other)
+            centre, peak = peak_at(centre, other)
+            return dataclasses.replace(
+                found, centre=centre, peak=peak, other=other, searched=searched + 1
+            )
 
-    def _filter_peak(self, frame, at, size, angle) -> tuple[np.ndarray, float]:
-        """(centre, value) of the translation filter's peak in its search region around ``at``."""
-        return self._region_peak(self._translation_filter.sample(frame, at, size, angle))
-
-    def _region_peak(self, region) -> tuple[np.ndarray, float]:
-        """(centre, value) of the translation filter's peak in a sampled search ``region``."""
-        tf = self._translation_filter
-        return region.center + tf.estimate(region), tf.response_peak
+        return self._workers.submit(search)
 
     def _filter_confident(self) -> bool:
         """

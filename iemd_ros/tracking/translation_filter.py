@@ -255,9 +255,47 @@ class TranslationFilter:
             (2,) displacement, image px.
 
         """
+        scores, region, resp, move, value = self._detect(region)
+        if scores is not None:
+            self._scores = scores
+        self._detection = region
+        cell_px, axes = features.CELL * region.scale, window_axes(region.angle)
+        self._response = (resp, region.pos, cell_px, axes)
+        self.response_peak = value
+        return move
+
+    def locate(self, region: Region) -> tuple[np.ndarray, float]:
+        """
+        Return where the response over ``region`` peaks, as :meth:`estimate`, keeping nothing.
+
+        It reads the filter and the colour model, so it may run beside :meth:`estimate` while
+        neither learns.
+
+        Parameters
+        ----------
+        region : Region
+            :meth:`sample` of the frame around a window.
+
+        Returns
+        -------
+        move : ndarray
+            (2,) displacement from the region's window centre to the peak, image px.
+        value : float
+            The response at the peak.
+
+        """
+        return self._detect(region)[3:]
+
+    def _detect(self, region: Region):
+        """
+        (colour scores, region with its colour channel, response, displacement, peak value).
+
+        The colour scores are the colour model's as it is now (None without one).
+        """
+        scores = None
         if self.colour_model is not None:
-            self._scores = self.colour_model.pixel_scores()
-            colour = self._colour_channel(region.patch)[None]
+            scores = self.colour_model.pixel_scores()
+            colour = self._colour_channel(region.patch, scores)[None]
             region = region._replace(
                 zf=np.concatenate([region.zf, self._windowed_spectrum(colour, len(region.zf))]),
                 patch=None,
@@ -267,11 +305,8 @@ class TranslationFilter:
         resp = sfft.irfft2(rf, s=self.map_hw)
         dy, dx, value = self.peak(resp, rf)
         cell_px = features.CELL * region.scale
-        axes = window_axes(region.angle)
-        self._detection = region
-        self._response = (resp, region.pos, cell_px, axes)
-        self.response_peak = value
-        return axes @ (np.array([dx, dy]) * cell_px) + region.pos - region.center
+        move = window_axes(region.angle) @ (np.array([dx, dy]) * cell_px) + region.pos
+        return scores, region, resp, move - region.center, value
 
     def response_at(self, point) -> float:
         """
@@ -388,7 +423,9 @@ class TranslationFilter:
             How many strips the frame has at this scale.
 
         """
-        z = self._with_colour(strip.features, strip.patch) * self.channel_weight[:, None, None]
+        scores = None if self.colour_model is None else self.colour_model.pixel_scores()
+        z = self._with_colour(strip.features, strip.patch, scores)
+        z = z * self.channel_weight[:, None, None]
         crop, origin = self._frame_crop()
         cells, first, lo = strip.cells, strip.first, strip.lo
         # sizes the FFT factors well
@@ -550,27 +587,31 @@ class TranslationFilter:
         side = self.support * scale
         return sample_region(frame, pos, (side, side), (self.support, self.support), angle)
 
-    def _colour_channel(self, patch: np.ndarray) -> np.ndarray:
+    def _colour_channel(self, patch: np.ndarray, scores) -> np.ndarray:
         """
         Return the colour model's score of ``patch``'s pixels averaged over each cell, less 1/2.
 
-        The score is the one of the last estimate (``_scores``); pixels beyond the last full cell
-        are ignored, as :func:`features.extract` ignores them.
+        ``scores`` is :meth:`ColourModel.pixel_scores`; pixels beyond the last full cell are
+        ignored, as :func:`features.extract` ignores them.
         """
         rows, cols = patch.shape[0] // features.CELL, patch.shape[1] // features.CELL
-        beta = self._scores(patch)[:rows * features.CELL, :cols * features.CELL]
+        beta = scores(patch)[:rows * features.CELL, :cols * features.CELL]
         # an integer shrink by area is the mean over each cell
         return cv2.resize(beta, (cols, rows), interpolation=cv2.INTER_AREA) - np.float32(0.5)
 
     def _features(self, patch: np.ndarray) -> np.ndarray:
-        """Return every feature channel of ``patch`` (:func:`features.extract`, the colour's)."""
-        return self._with_colour(features.extract(patch, self.colour), patch)
+        """
+        Return every feature channel of ``patch`` (:func:`features.extract`, the colour's).
 
-    def _with_colour(self, x: np.ndarray, patch: np.ndarray) -> np.ndarray:
+        The colour channel is scored as at the last estimate.
+        """
+        return self._with_colour(features.extract(patch, self.colour), patch, self._scores)
+
+    def _with_colour(self, x: np.ndarray, patch: np.ndarray, scores) -> np.ndarray:
         """Return the channels ``x`` of ``patch`` and, with a colour model, its colour channel."""
         if self.colour_model is None:
             return x
-        return np.concatenate([x, self._colour_channel(patch)[None]])
+        return np.concatenate([x, self._colour_channel(patch, scores)[None]])
 
     def _windowed_spectrum(self, x: np.ndarray, first: int = 0) -> np.ndarray:
         """Return the spectrum of feature channels ``x``, the filter's ``first`` on, windowed."""
