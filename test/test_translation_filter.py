@@ -340,7 +340,7 @@ def test_search_frame_finds_the_target_moved_anywhere_in_a_drone_frame(uav_root)
     cell_px = tf.cell_size(box[2:])
     for move in [(0.0, 0.0), (400.0, -150.0), (-300.0, -350.0)]:  # she is at (540, 555)
         moved = shifted(frame, *move)
-        parts = tf.search_frame(tf.frame_strip(moved, box[2:], 0))[2]
+        parts = tf.frame_strip(moved, box[2:], 0).parts
         assert parts > 1  # a 1280x720 frame is searched over several lost frames
         found = max(
             (tf.search_frame(tf.frame_strip(moved, box[2:], part)) for part in range(parts)),
@@ -369,11 +369,11 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     size = box[2:] * 0.5  # the frame at a larger scale: more strips
     strips = []
     extract = features.extract
-    # the features as extracted (frame_response weighs a copy)
+    # the features as extracted (the strip keeps a copy)
     monkeypatch.setattr(
         features, 'extract', lambda *a: strips.append(extract(*a)) or strips[-1].copy()
     )
-    parts = tf.frame_response(tf.frame_strip(frame, size, 0))[3]
+    parts = tf.frame_strip(frame, size, 0).parts
     assert parts >= 3
     h = sfft.irfft2(tf.f, s=tf.map_hw, axes=(1, 2))
     crop = h[(slice(None),) + tf.target_cells]
@@ -382,7 +382,8 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
     oy, ox = (k // 2 - t.start for k, t in zip(tf.map_hw, tf.target_cells))
     for part in range(parts):
         strips.clear()
-        resp, first, cell_px, _ = tf.frame_response(tf.frame_strip(frame, size, part))
+        strip = tf.frame_strip(frame, size, part)
+        resp, first, cell_px = tf.frame_response(strip), strip.first, strip.cell_px
         z = strips[0]
         z[features.CN_START:] *= CN_WEIGHT
         lo = max(first - ox, 0)
@@ -393,7 +394,7 @@ def test_the_frame_response_is_the_linear_correlation_of_each_strip(uav_root, mo
         kept = direct[m - 1 - oy:][:rows, l_ - 1 - ox + first - lo:][:, :cols]
         assert kept.shape == resp.shape and rows * cell_px[1] == pytest.approx(frame.shape[0])
         np.testing.assert_allclose(resp, kept, rtol=0, atol=1e-5 * np.abs(kept).max())
-        centre, value, _ = tf.search_frame(tf.frame_strip(frame, size, part))
+        centre, value = tf.search_frame(strip)
         k = np.unravel_index(np.argmax(resp), resp.shape)
         assert value == resp[k]
         np.testing.assert_allclose(centre, (np.array([k[1] + first, k[0]]) + 0.5) * cell_px - 0.5)

@@ -282,7 +282,7 @@ class IemdTracker:
         # sums of the filter's (peak, APCE) over the frames that learned, and their count
         self._peak_apce_sums, self._peak_apce_count = np.zeros(2), 0
         self._peak_apce = None  # this frame's (peak, APCE), learned from if the frame is tracked
-        # the strip of the frame the next lost frame searches (TranslationFilter.search_frame)
+        # the strip of the frame the next lost frame searches (TranslationFilter.frame_strip)
         self._search_part = 0
         self._lost_frames = 0  # lost frames in a row
         # lost: count, sum and sum of squares of re-detection's best peak on this loss's frames
@@ -611,7 +611,8 @@ class IemdTracker:
             if in_view:
                 candidates.append(peak_at(anchor, size) + (anchor,))
             if scan and not (candidates and candidates[0][1] >= wanted):
-                coarse, _, parts = tf.search_frame(tf.frame_strip(frame, size, part))
+                strip = tf.frame_strip(frame, size, part)
+                coarse, parts = tf.search_frame(strip)[0], strip.parts
                 candidates.append(peak_at(coarse, size) + (coarse,))
             if not candidates:
                 return _Found(wanted, level)

@@ -111,7 +111,7 @@ class Strip(NamedTuple):
     patch: np.ndarray    # the strip with its margins, resampled to the filter's scale
     features: np.ndarray  # (C, rows, cols) its feature channels, without the colour channel
     lo: int              # the frame's cell column of the patch's first column
-    first: int           # the frame's cell column of the strip's first column
+    first: int           # the frame's cell column of the strip's (and its response's) first column
     width: int           # the strip's own columns (the last strip may have fewer in the frame)
     cells: tuple         # the frame's (rows, cols) cells at this scale
     cell_px: np.ndarray  # (x, y) size of a cell in frame pixels
@@ -321,7 +321,7 @@ class TranslationFilter:
         d = axes.T @ (np.asarray(point, dtype=np.float64) - pos) / cell_px
         return _bilinear_circular(resp, float(d[1]), float(d[0]))
 
-    def search_frame(self, strip: Strip) -> tuple[np.ndarray, float, int]:
+    def search_frame(self, strip: Strip) -> tuple[np.ndarray, float]:
         """
         Where in one strip of a frame the filter responds most.
 
@@ -339,15 +339,13 @@ class TranslationFilter:
             (cx, cy) of the strongest response in the strip, image px (pixel centres at integers).
         response : float
             The response there (no cosine window, so not comparable with :attr:`response_peak`:
-            check a candidate with :meth:`estimate`).
-        parts : int
-            How many strips the frame has at this scale.
+            check a candidate with :meth:`estimate` or :meth:`locate`).
 
         """
-        resp, first, cell_px, parts = self.frame_response(strip)
+        resp = self.frame_response(strip)
         k = np.unravel_index(int(np.argmax(resp)), resp.shape)
-        centre = (np.array([k[1] + first, k[0]], dtype=np.float64) + 0.5) * cell_px - 0.5
-        return centre, float(resp[k]), parts
+        centre = (np.array([k[1] + strip.first, k[0]], dtype=np.float64) + 0.5) * strip.cell_px
+        return centre - 0.5, float(resp[k])
 
     def frame_strip(self, frame: np.ndarray, size, part: int = 0) -> Strip:
         """
@@ -393,7 +391,7 @@ class TranslationFilter:
             patch, features.extract(patch, self.colour), lo, first, width, cells, cell_px, parts
         )
 
-    def frame_response(self, strip: Strip) -> tuple[np.ndarray, int, np.ndarray, int]:
+    def frame_response(self, strip: Strip) -> np.ndarray:
         """
         Return the filter's response over one strip of a frame.
 
@@ -411,16 +409,10 @@ class TranslationFilter:
 
         Returns
         -------
-        response : ndarray
+        ndarray
             (rows, cols) response at the strip's cells inside the frame; a cell answers for a
-            target centred on it.
-        first : int
-            The frame's cell column of the response's first column.
-        cell_px : ndarray
-            (x, y) size of a cell in frame pixels: cell (i, j) is centred at
-            ``((j + first, i) + 0.5) * cell_px - 0.5``.
-        parts : int
-            How many strips the frame has at this scale.
+            target centred on it: cell (i, j) is centred at ``((j + strip.first, i) + 0.5) *
+            strip.cell_px - 0.5`` in the frame.
 
         """
         scores = None if self.colour_model is None else self.colour_model.pixel_scores()
@@ -443,7 +435,7 @@ class TranslationFilter:
         resp = np.roll(sfft.irfft2(resp_f, s=shape), origin, axis=(0, 1))[
             :cells[0], first - lo:min(first + strip.width, cells[1]) - lo
         ]
-        return resp, first, strip.cell_px, strip.parts
+        return resp
 
     def _frame_crop(self) -> tuple[tuple[int, int], tuple[int, int]]:
         """
