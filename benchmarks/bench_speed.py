@@ -38,14 +38,18 @@ from the frame and the next update waits for them, so back to back each timed up
 learning of the frame before: the times are whole frames.  A tracker that has lost the target may
 run faster (OpenCV skips its model update on a failed frame), so the number of frames each tracker
 reported failed is shown.  Prints median / p95 update time (ms) and fps per tracker, and the fps
-ratio of each tracker against the reference (CSRT by default) per sequence and pooled.
+ratio of each tracker against the reference (CSRT by default) per sequence and pooled.  With
+``--repeats N`` every sequence is run N times (the trackers interleaved each time), the figures
+pool all runs, and the pooled ratio is also printed per repeat with its median and range: on a
+shared machine one run's ratio swings by a tenth or more.
 
 Sequences: a few OTB sequences and 1280x720 drone sequences (init on their first GT box) plus the
 640x480 CMU desk frames (``../shared/data/imu/cmu_hwangbo_desk``, init on the first box of
 ``gt_eagle_head.txt``).  Besides each sequence, the frames are pooled by class: up to 640x480
 pixels, and larger (the 1280x720 drone frames).
 
-    PYTHONPATH=. .venv/bin/python benchmarks/bench_speed.py [--trackers iemd,csrt] [--frames 150]
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_speed.py [--trackers iemd,csrt] [--frames 150] \
+        [--repeats 3]
 """
 from __future__ import annotations
 
@@ -90,6 +94,7 @@ def _main(argv) -> int:
         help='sequences of ../shared/data/otb and ../shared/data/uav',
     )
     p.add_argument('--frames', type=int, default=150)
+    p.add_argument('--repeats', type=int, default=1, help='runs of every sequence, interleaved')
     p.add_argument('--no-desk', action='store_true', help='skip the 640x480 CMU desk frames')
     p.add_argument(
         '--cv-threads',
@@ -101,6 +106,8 @@ def _main(argv) -> int:
     trackers = [t.strip() for t in args.trackers.split(',') if t.strip()]
     if args.frames < 2:
         raise ValueError(f'--frames must be >= 2, got {args.frames}')
+    if args.repeats < 1:
+        raise ValueError(f'--repeats must be >= 1, got {args.repeats}')
     for t in trackers:
         make_tracker(t)
     if args.reference not in trackers:
@@ -120,13 +127,14 @@ def _main(argv) -> int:
 
     if args.cv_threads is not None:
         cv2.setNumThreads(args.cv_threads)
-    pooled: dict[str, dict[str, list[np.ndarray]]] = {
-        c: {t: [] for t in trackers} for c in CLASSES
+    # per class, tracker and repeat: the update times (ms) of every sequence's run
+    pooled: dict[str, dict[str, list[list[np.ndarray]]]] = {
+        c: {t: [[] for _ in range(args.repeats)] for t in trackers} for c in CLASSES
     }
     failed: dict[str, dict[str, int]] = {c: {t: 0 for t in trackers} for c in CLASSES}
     print(
         f'OpenCV {cv2.__version__}, cv2.getNumThreads() = {cv2.getNumThreads()}; {args.frames} '
-        'frames/sequence'
+        f'frames/sequence, {args.repeats} run(s) of each'
     )
     print(
         f'{"sequence":<22} {"tracker":<6} {"median ms":>10} {"p95 ms":>8} {"fps":>8} {"ratio":>7} '
@@ -135,21 +143,38 @@ def _main(argv) -> int:
     for load in loaders:
         name, frames, box = load()
         kind = CLASSES[0] if frames[0].shape[0] * frames[0].shape[1] <= 640 * 480 else CLASSES[1]
-        ms, fails = {}, {}
+        ms, fails = {t: [] for t in trackers}, {t: 0 for t in trackers}
+        for r in range(args.repeats):
+            for t in trackers:
+                run = run_tracker(make_tracker(t), frames, box)
+                ms[t].append(1e3 * run.update_seconds)
+                pooled[kind][t][r].append(ms[t][-1])
+                fails[t] += int((~run.ok).sum())
         for t in trackers:
-            run = run_tracker(make_tracker(t), frames, box)
-            ms[t], fails[t] = 1e3 * run.update_seconds, int((~run.ok).sum())
-            pooled[kind][t].append(ms[t])
             failed[kind][t] += fails[t]
-        _report(name, ms, fails, args.reference)
+        _report(name, {t: np.concatenate(v) for t, v in ms.items()}, fails, args.reference)
     for kind in CLASSES:
-        if pooled[kind][args.reference]:
-            _report(
-                f'{kind} (pooled)',
-                {t: np.concatenate(v) for t, v in pooled[kind].items()},
-                failed[kind],
-                args.reference,
-            )
+        if not pooled[kind][args.reference][0]:
+            continue
+        runs = {t: [np.concatenate(v) for v in repeats] for t, repeats in pooled[kind].items()}
+        _report(
+            f'{kind} (pooled)',
+            {t: np.concatenate(v) for t, v in runs.items()},
+            failed[kind],
+            args.reference,
+        )
+        if args.repeats > 1:
+            for t in trackers:
+                if t == args.reference:
+                    continue
+                ratios = [
+                    runs[args.reference][r].mean() / runs[t][r].mean() for r in range(args.repeats)
+                ]
+                print(
+                    f'{"":<22} {t}/{args.reference} per run: '
+                    + ', '.join(f'{x:.2f}' for x in ratios)
+                    + f'; median {np.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f})'
+                )
     return 0
 
 
