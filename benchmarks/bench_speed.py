@@ -171,7 +171,7 @@ def _main(argv) -> int:
                     runs[args.reference][r].mean() / runs[t][r].mean() for r in range(args.repeats)
                 ]
                 print(
-                    f'{"":<22} {t}/{args.reference} per run: '
+                    f'{"":<22} {t}/{args.reference} per repeat: '
                     + ', '.join(f'{x:.2f}' for x in ratios)
                     + f'; median {np.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f})'
                 )
