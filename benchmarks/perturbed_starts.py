@@ -82,6 +82,7 @@ from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation.metrics import paired_difference, score_sequence, valid_boxes
 from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.split import PARTS, split_names
+from iemd_ros.tracking.appearance import grey_levels
 import numpy as np
 
 # Starts as (x, y) shift of the centre in units of ``shift`` times the box's size, the box's
@@ -162,8 +163,8 @@ def _as_camera(frames, boxes, factor: float, mono: bool) -> tuple[list, np.ndarr
     boxes = np.asarray(boxes, dtype=float)
     out, ratio = [], np.ones(2)
     for frame in frames:
-        if mono and frame.ndim == 3:
-            frame = cv2.cvtColor(frame, cv2.COLOR_BGR2GRAY)
+        if mono:
+            frame = grey_levels(frame)
         if factor != 1.0:
             h, w = frame.shape[:2]
             size = (max(1, round(w * factor)), max(1, round(h * factor)))

@@ -584,7 +584,7 @@ class IemdTracker:
         where it happened), one strip of the whole frame (the frame is scanned over lost frames)
         refined by a search at its peak.  Where no peak reaches the level of :func:`_found_level`,
         the highest, if more than a cell from the centre of the region it was found in, is
-        measured again in a region centred on it (the cosine window weakens a peak off the
+        searched again in a region centred on it (the cosine window weakens a peak off the
         centre); then, still short, the filter searches its place at one other size of
         ``REDETECT_SIZES`` (a target may come back nearer or farther).  None without the filter or
         before any frame learned.  The search runs on a worker beside the local search: it keeps
@@ -617,7 +617,7 @@ class IemdTracker:
             if not candidates:
                 return _Found(wanted, level)
             (centre, peak, at), searched = max(candidates, key=lambda c: c[1]), len(candidates)
-            # a peak off its region's centre is weakened by the cosine window: measured on it
+            # the cosine window weakens a peak off the region's centre: search again centred on it
             if peak < wanted and np.hypot(*(centre - at)) > tf.cell_size(size):
                 centre, peak = peak_at(centre, size)
                 searched += 1

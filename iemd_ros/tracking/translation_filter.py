@@ -325,13 +325,8 @@ class TranslationFilter:
         """
         Where in one strip of a frame the filter responds most.
 
-        The response is :meth:`frame_response`'s.  A caller scans the whole frame by asking for
-        parts 0, 1, ... of :meth:`frame_strip` over several frames.
-
-        Parameters
-        ----------
-        strip : Strip
-            :meth:`frame_strip` of the frame.
+        The response is :meth:`frame_response`'s, of the ``strip`` it takes.  A caller scans the
+        whole frame by asking for parts 0, 1, ... of :meth:`frame_strip` over several frames.
 
         Returns
         -------
@@ -595,7 +590,7 @@ class TranslationFilter:
         """
         Return every feature channel of ``patch`` (:func:`features.extract`, the colour's).
 
-        The colour channel is scored as at the last estimate.
+        The colour channel reads the colour scores of the last estimate (``_scores``).
         """
         return self._with_colour(features.extract(patch, self.colour), patch, self._scores)
 
