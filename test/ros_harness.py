@@ -303,14 +303,20 @@ class Driver:
                 out.append(d)
         return out
 
-    def wait_status(self, kind: str, predicate, timeout: float = 5.0):
-        """
-        First diagnostics status of ``kind`` (received from now on) satisfying ``predicate``.
-
-        Or None.
-        """
+    def diagnostics_mark(self) -> int:
+        """Return the count of diagnostics arrays received so far (a ``since`` for wait_status)."""
         with self.cond:
-            start = len(self.diagnostics)
+            return len(self.diagnostics)
+
+    def wait_status(self, kind: str, predicate, timeout: float = 5.0, since: int | None = None):
+        """
+        First diagnostics status of ``kind`` satisfying ``predicate``, or None.
+
+        Among the arrays received from :meth:`diagnostics_mark`'s ``since`` on (default: from now
+        on): a status that covers a window of events (a topic's stamp ages) may be published
+        between the events and this call.
+        """
+        start = self.diagnostics_mark() if since is None else since
         found = []
 
         def check():
