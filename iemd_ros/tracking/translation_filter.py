@@ -255,12 +255,10 @@ class TranslationFilter:
             (2,) displacement, image px.
 
         """
-        scores, region, resp, move, value = self._detect(region)
+        scores, region, self._response, move, value = self._detect(region)
         if scores is not None:
             self._scores = scores
         self._detection = region
-        cell_px, axes = features.CELL * region.scale, window_axes(region.angle)
-        self._response = (resp, region.pos, cell_px, axes)
         self.response_peak = value
         return move
 
@@ -290,7 +288,9 @@ class TranslationFilter:
         """
         (colour scores, region with its colour channel, response, displacement, peak value).
 
-        The colour scores are the colour model's as it is now (None without one).
+        The colour scores are the colour model's as it is now (None without one); the response is
+        kept with its geometry, as :meth:`response_at` reads it: (response, region position, cell
+        size px, axes).
         """
         scores = None
         if self.colour_model is not None:
@@ -304,9 +304,9 @@ class TranslationFilter:
         correlate(self.f, region.zf, rf)
         resp = sfft.irfft2(rf, s=self.map_hw)
         dy, dx, value = self.peak(resp, rf)
-        cell_px = features.CELL * region.scale
-        move = window_axes(region.angle) @ (np.array([dx, dy]) * cell_px) + region.pos
-        return scores, region, resp, move - region.center, value
+        cell_px, axes = features.CELL * region.scale, window_axes(region.angle)
+        move = axes @ (np.array([dx, dy]) * cell_px) + region.pos - region.center
+        return scores, region, (resp, region.pos, cell_px, axes), move, value
 
     def response_at(self, point) -> float:
         """
