@@ -79,10 +79,11 @@ class OracleTracker(IemdTracker):
     def __init__(self, gt: np.ndarray, oracles: frozenset):
         super().__init__()
         self._gt, self._oracles = gt, oracles
+        self._frame = 0  # the index of the frame being tracked
 
     def _truth(self):
         """Return the ground-truth box of the frame being tracked, or None where it is absent."""
-        box = self._gt[self._frame_index]
+        box = self._gt[self._frame]
         return box if np.all(np.isfinite(box)) else None
 
     def _search(self, models, prediction):
@@ -105,8 +106,9 @@ class OracleTracker(IemdTracker):
             scale = np.sqrt([area * ratio, area / ratio]) / best.model.size
         return found, scale
 
-    def update(self, frame, prior=None):
-        result = super().update(frame, prior)
+    def update(self, frame, prior=None, interval=None):
+        self._frame += 1
+        result = super().update(frame, prior, interval)
         # the geometric mean: the aspect oracle's pair gives its area's scale, one scale itself
         return dataclasses.replace(result, scale=float(np.exp(np.mean(np.log(result.scale)))))
 

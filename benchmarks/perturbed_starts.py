@@ -71,6 +71,7 @@ import argparse
 import ast
 import datetime
 import hashlib
+import itertools
 import json
 from multiprocessing import Pool
 from pathlib import Path
@@ -131,9 +132,9 @@ def run(job):
 
     Decoded once.
     """
-    name, runs, shift, starts, resolution, mono = job
+    name, runs, shift, starts, resolution, mono, every, interval = job
     seq = load_sequence(name)
-    frames, truth = _as_camera(seq.frames(), seq.gt_boxes, resolution, mono)
+    frames, truth = _as_camera(seq.frames(), seq.gt_boxes, resolution, mono, every)
     begins = []  # (first frame, box) of each start, the same for every tracker
     for dx, dy, scale, at in starts:
         k = start_frame(truth, at)
@@ -143,26 +144,27 @@ def run(job):
         rows = []
         for k, start in begins:
             tracker = make_tracker(tracker_name, config)
-            result = run_tracker(tracker, frames[k:], start)
+            result = run_tracker(tracker, frames[k:], start, interval)
             scores = score_sequence(result.boxes, truth[k:], name)
             rows.append((scores.average_overlap, float(np.median(result.update_seconds) * 1e3)))
         out.append(rows)
     return out
 
 
-def _as_camera(frames, boxes, factor: float, mono: bool) -> tuple[list, np.ndarray]:
+def _as_camera(frames, boxes, factor: float, mono: bool, every: int) -> tuple[list, np.ndarray]:
     """
     Return the decoded frames and 0-based ground-truth boxes as another camera would give them.
 
-    That camera has ``factor`` times the frames' resolution and, with ``mono``, one grey channel.
+    That camera has ``factor`` times the frames' resolution, with ``mono`` one grey channel, and
+    takes every ``every``-th frame.
 
     Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
     ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
     """
-    boxes = np.asarray(boxes, dtype=float)
+    boxes = np.asarray(boxes, dtype=float)[::every]
     out, ratio = [], np.ones(2)
-    for frame in frames:
+    for frame in itertools.islice(frames, 0, None, every):
         if mono:
             frame = grey_levels(frame)
         if factor != 1.0:
@@ -211,6 +213,20 @@ def main() -> None:
     parser.add_argument(
         '--mono', action='store_true', help='frames turned to one-channel grey (a mono camera)'
     )
+    parser.add_argument(
+        '--frame-rate',
+        type=float,
+        default=None,
+        metavar='HZ',
+        help="the sequences' own frame rate, which iEMD is told (default: unknown)",
+    )
+    parser.add_argument(
+        '--every',
+        type=int,
+        default=1,
+        help='every N-th frame only, as a camera at 1/N of the rate; iEMD is told the interval, '
+        'N frames at --frame-rate or, unknown, at its reference rate (default: 1)',
+    )
     parser.add_argument('--jobs', type=int, default=2)
     parser.add_argument(
         '--save', type=Path, help='write the average overlap of every run to this JSON file'
@@ -221,6 +237,12 @@ def main() -> None:
     args = parser.parse_args()
     if not 0.0 < args.resolution <= 1.0:
         parser.error(f'--resolution must be in (0, 1], got {args.resolution}')
+    if args.every < 1:
+        parser.error(f'--every must be >= 1, got {args.every}')
+    if args.frame_rate is not None and not args.frame_rate > 0:
+        parser.error(f'--frame-rate must be > 0, got {args.frame_rate}')
+    rate = args.frame_rate or (None if args.every == 1 else TrackerConfig().reference_rate)
+    interval = None if rate is None else args.every / rate
     names = sequence_names(args.sequences)
     if args.split is not None:
         names = [n for n in names if n in split_names(args.split)]
@@ -229,7 +251,8 @@ def main() -> None:
         None
         if args.against is None
         else _load_reference(
-            args.against, args.starts, args.shift, args.resolution, args.mono, names
+            args.against, args.starts, args.shift, args.resolution, args.mono, args.every,
+            args.frame_rate, names,
         )
     )
     digest = _tracker_digest()
@@ -250,7 +273,10 @@ def main() -> None:
         results = pool.map(
             run,
             [
-                (name, runs, args.shift, START_SETS[args.starts], args.resolution, args.mono)
+                (
+                    name, runs, args.shift, START_SETS[args.starts], args.resolution, args.mono,
+                    args.every, interval,
+                )
                 for name in names
             ],
             chunksize=1,
@@ -267,6 +293,8 @@ def main() -> None:
         f'{len(names)} sequences x {n_starts} starts ({which})'
         + ('' if args.resolution == 1.0 else f', frames at {args.resolution:g} of their size')
         + (', one-channel grey frames' if args.mono else '')
+        + ('' if args.every == 1 else f', every {args.every}th frame')
+        + ('' if interval is None else f', iEMD told the frames are {interval * 1e3:.1f} ms apart')
     )
     overlaps = {}
     first = runs[0][0]
@@ -305,6 +333,8 @@ def main() -> None:
                     'shift': args.shift,
                     'resolution': args.resolution,
                     'mono': args.mono,
+                    'every': args.every,
+                    'frame_rate': args.frame_rate,
                     'tracker_sources': digest,
                     'saved': datetime.datetime.now().isoformat(timespec='seconds'),
                     'runs': {
@@ -339,7 +369,8 @@ def _tracker_digest() -> str:
 
 
 def _load_reference(
-    path: Path, starts: str, shift: float, resolution: float, mono: bool, names
+    path: Path, starts: str, shift: float, resolution: float, mono: bool, every: int, frame_rate,
+    names,
 ) -> tuple[str, np.ndarray, str]:
     """
     (label, AO % per sequence of ``names`` and start, source) of the first tracker saved by --save.
@@ -347,8 +378,8 @@ def _load_reference(
     Its source: the digest of the tracker sources it ran and when, as far as the file records them.
 
     SystemExit with one line for a file that is not such a run, or one of other starts, shift,
-    resolution or frames (a file without them is at full resolution, in the frames' own colour),
-    or without a run of one of ``names``.
+    resolution, frames or frame rate (a file without them is at full resolution, in the frames'
+    own colour, every frame, of an unknown rate), or without a run of one of ``names``.
     """
     try:
         saved = json.loads(path.read_text())
@@ -357,13 +388,15 @@ def _load_reference(
         raise SystemExit(f'--against {path}: not a run saved by --save ({exc})') from None
     saved_as = (
         saved.get('starts'), saved.get('shift'), saved.get('resolution', 1.0),
-        saved.get('mono', False),
+        saved.get('mono', False), saved.get('every', 1), saved.get('frame_rate'),
     )
-    if saved_as != (starts, shift, resolution, mono):
+    if saved_as != (starts, shift, resolution, mono, every, frame_rate):
         raise SystemExit(
             f'--against {path}: saved with --starts {saved_as[0]} --shift {saved_as[1]} '
-            f'--resolution {saved_as[2]}{" --mono" * saved_as[3]}, this run uses --starts '
-            f'{starts} --shift {shift} --resolution {resolution}{" --mono" * mono}'
+            f'--resolution {saved_as[2]}{" --mono" * saved_as[3]} --every {saved_as[4]} '
+            f'--frame-rate {saved_as[5]}, this run uses --starts {starts} --shift {shift} '
+            f'--resolution {resolution}{" --mono" * mono} --every {every} --frame-rate '
+            f'{frame_rate}'
         )
     missing = [n for n in names if n not in runs]
     if missing:

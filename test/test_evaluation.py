@@ -76,12 +76,15 @@ class _Oracle:
 
     gt: np.ndarray
 
+    intervals: list = []  # every update's interval, in order
+
     def init(self, frame, box):
         assert int(frame[0, 0, 0]) == 0
         np.testing.assert_array_equal(box, self.gt[0])
 
-    def update(self, frame):
+    def update(self, frame, interval=None):
         k = int(round(frame.mean()))
+        self.intervals.append(interval)
         return self.gt[k], k != 3  # reports one failure, at frame index 3
 
 
@@ -115,12 +118,25 @@ def test_protocol_with_oracle_tracker(tmp_path, monkeypatch, capsys):
     assert 'Toy' in capsys.readouterr().out
 
 
+def test_a_frame_rate_gives_the_tracker_the_frames_interval(tmp_path, monkeypatch):
+    root, gt = _synthetic_root(tmp_path)
+    monkeypatch.setattr(_Oracle, 'gt', gt)
+    monkeypatch.setattr(_Oracle, 'intervals', [])
+    monkeypatch.setitem(evaluation.TRACKERS, 'oracle', _Oracle)
+    argv = [str(root), '--trackers', 'oracle', '--out', str(tmp_path / 'out'), '--jobs', '1']
+    assert main(argv + ['--frame-rate', '12.5']) == 0
+    assert _Oracle.intervals == [0.08] * 5
+    _Oracle.intervals.clear()
+    assert main(argv) == 0  # the OTB layout records no rate
+    assert _Oracle.intervals == [None] * 5
+
+
 def test_run_tracker_keeps_last_box_when_tracker_returns_none():
     class Flaky:
         def init(self, frame, box):
             self.k = 0
 
-        def update(self, frame):
+        def update(self, frame, interval=None):
             self.k += 1
             if self.k in (2, 3):
                 return np.zeros(4), False  # what cv2.TrackerCSRT/KCF return when lost
@@ -251,6 +267,8 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
             'not allowed with',
         ),
         (['--max-frames', '1', '--trackers', 'kcf'], 'must be >= 2'),
+        (['--frame-rate', '0', '--trackers', 'kcf'], 'must be a finite number > 0'),
+        (['--frame-rate', 'fast', '--trackers', 'kcf'], 'not a number'),
         (['--bogus'], 'unrecognized arguments'),
         (['/no/such/dir', '--trackers', 'kcf'], 'neither an OTB root nor a sequence folder'),
         (['--config', '/no/such/params.yaml', '--trackers', 'iemd'], 'cannot read config'),

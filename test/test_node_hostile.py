@@ -179,11 +179,11 @@ def test_an_internal_error_clears_on_the_next_good_frame(ctx, seq, monkeypatch):
         update = IemdTracker.update
         calls = []
 
-        def broken_once(self, frame, prior=None):
+        def broken_once(self, frame, prior=None, interval=None):
             calls.append(1)
             if len(calls) == 1:
                 raise RuntimeError('a bug')
-            return update(self, frame, prior)
+            return update(self, frame, prior, interval)
 
         monkeypatch.setattr(IemdTracker, 'update', broken_once)
         drv.publish_image(seq.frames[2], s[2])
@@ -209,12 +209,12 @@ def test_a_hung_tracker_update_is_abandoned_and_the_tracker_rebuilt(ctx, seq, mo
     update = IemdTracker.update
     calls = []
 
-    def hangs_once(self, frame, prior=None):
+    def hangs_once(self, frame, prior=None, interval=None):
         calls.append(1)
         if len(calls) == 2:
             # as the hung calcOpticalFlowPyrLK
             release.wait(120.0)
-        return update(self, frame, prior)
+        return update(self, frame, prior, interval)
 
     monkeypatch.setattr(IemdTracker, 'update', hangs_once)
     try:

@@ -77,11 +77,11 @@ def test_the_pipeline_answers_a_frame_whose_update_hangs_and_tracks_the_next(mon
     release, armed = threading.Event(), []
     update = IemdTracker.update
 
-    def hangs_once(self, frame, prior=None):
+    def hangs_once(self, frame, prior=None, interval=None):
         if armed:
             armed.pop()
             release.wait(60.0)
-        return update(self, frame, prior)
+        return update(self, frame, prior, interval)
 
     p = TrackingPipeline(PipelineConfig(use_gyro=False, watchdog_ms=100.0))
     monkeypatch.setattr(IemdTracker, 'update', hangs_once)
@@ -115,10 +115,10 @@ def test_an_offline_pipeline_waits_for_a_slow_update_in_the_callers_thread(monke
     s = [int(v) for v in seq.frame_stamps_ns]
     update, callers = IemdTracker.update, set()
 
-    def slow(self, frame, prior=None):
+    def slow(self, frame, prior=None, interval=None):
         callers.add(threading.get_ident())
         threading.Event().wait(0.3)
-        return update(self, frame, prior)
+        return update(self, frame, prior, interval)
 
     p = TrackingPipeline(PipelineConfig(use_gyro=False, watchdog_ms=100.0), live=False)
     monkeypatch.setattr(IemdTracker, 'update', slow)

@@ -53,6 +53,8 @@ jobs, but for its wall-clock fields (fps, timings): the last line prints its dig
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import math
 from pathlib import Path
 import sys
 import time
@@ -99,6 +101,16 @@ def _positive_int(text: str) -> int:
     return v
 
 
+def _positive_float(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
+    if not (math.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f'must be a finite number > 0, got {text!r}')
+    return v
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = CliParser(
         prog='iemd-eval',
@@ -133,6 +145,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         '--max-frames', type=_positive_int, default=None, help='evaluate only the first N frames'
+    )
+    p.add_argument(
+        '--frame-rate',
+        type=_positive_float,
+        default=None,
+        metavar='HZ',
+        help="the sequences' frame rate, which the OTB layout does not record: iEMD's models "
+        "learn for the frames' interval (default: unknown, one frame at its reference rate)",
     )
     p.add_argument(
         '--out', type=Path, default=DEFAULT_OUT, help='output folder (default out/eval)'
@@ -189,6 +209,8 @@ def main(argv: list[str] | None = None) -> int:
                 raise ValueError(f"the inputs hold none of the {args.split} part's sequences")
         if args.max_frames is not None:
             sequences = [s.head(args.max_frames) for s in sequences]
+        if args.frame_rate is not None:
+            sequences = [dataclasses.replace(s, frame_rate=args.frame_rate) for s in sequences]
         n_jobs = len(trackers) * len(sequences)
         t_start = time.perf_counter()
         print(

@@ -44,6 +44,7 @@ absent.  Boxes are returned 0-based (``x - 1, y - 1``).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 import re
@@ -77,6 +78,8 @@ class Sequence:
         Frame numbers, from the file names.
     group : str, optional
         The folder of sequences it comes from (``otb``, ``uav``): means are taken per group.
+    frame_rate : float, optional
+        Frames per second, when known (the OTB layout does not record it).
 
     """
 
@@ -85,6 +88,7 @@ class Sequence:
     gt_boxes: np.ndarray
     frame_numbers: tuple[int, ...] = ()
     group: str = ''
+    frame_rate: float | None = None
 
     def __len__(self) -> int:
         return len(self.frame_paths)
@@ -111,8 +115,11 @@ class Sequence:
         """
         if n < 1:
             raise ValueError(f'{self.name}: number of frames must be >= 1, got {n}')
-        return Sequence(
-            self.name, self.frame_paths[:n], self.gt_boxes[:n], self.frame_numbers[:n], self.group
+        return dataclasses.replace(
+            self,
+            frame_paths=self.frame_paths[:n],
+            gt_boxes=self.gt_boxes[:n],
+            frame_numbers=self.frame_numbers[:n],
         )
 
     def frames(self) -> Iterator[np.ndarray]:

@@ -108,7 +108,7 @@ class TrackerAdapter(Protocol):
         """
         ...
 
-    def update(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
+    def update(self, frame: np.ndarray, interval: float | None = None) -> tuple[np.ndarray, bool]:
         """
         Track into the next frame.
 
@@ -116,6 +116,8 @@ class TrackerAdapter(Protocol):
         ----------
         frame : ndarray
             The frame, BGR uint8.
+        interval : float, optional
+            Seconds since the previous frame, when known.
 
         Returns
         -------
@@ -158,7 +160,7 @@ class OpenCVTracker:
         x, y, w, h = (int(round(v)) for v in box)
         self._tracker.init(frame, (x, y, max(w, 1), max(h, 1)))
 
-    def update(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
+    def update(self, frame: np.ndarray, interval: float | None = None) -> tuple[np.ndarray, bool]:
         """
         Track into the next frame.
 
@@ -166,6 +168,8 @@ class OpenCVTracker:
         ----------
         frame : ndarray
             The frame, BGR uint8.
+        interval : float, optional
+            Seconds since the previous frame, when known.
 
         Returns
         -------
@@ -175,7 +179,7 @@ class OpenCVTracker:
             False when the tracker reports a failure.
 
         """
-        ok, box = self._tracker.update(frame)
+        ok, box = self._tracker.update(frame)  # OpenCV's trackers learn per frame
         return np.asarray(box, dtype=float), bool(ok)
 
 
@@ -207,7 +211,7 @@ class IemdAdapter:
         """
         self._tracker.init(frame, tuple(float(v) for v in box))
 
-    def update(self, frame: np.ndarray) -> tuple[np.ndarray, bool]:
+    def update(self, frame: np.ndarray, interval: float | None = None) -> tuple[np.ndarray, bool]:
         """
         Track into the next frame.
 
@@ -215,6 +219,8 @@ class IemdAdapter:
         ----------
         frame : ndarray
             The frame, BGR uint8.
+        interval : float, optional
+            Seconds since the previous frame, when known.
 
         Returns
         -------
@@ -224,7 +230,7 @@ class IemdAdapter:
             False when the tracker reports the target lost.
 
         """
-        result = self._tracker.update(frame)
+        result = self._tracker.update(frame, interval=interval)
         return np.asarray(result.box, dtype=float), not bool(result.lost)
 
 
@@ -319,7 +325,7 @@ class RunResult:
         return len(self.boxes) / total if total > 0 else float('inf')
 
 
-def run_tracker(tracker: TrackerAdapter, frames, init_box) -> RunResult:
+def run_tracker(tracker: TrackerAdapter, frames, init_box, interval=None) -> RunResult:
     """
     One-pass run: init on the first frame with ``init_box``, update on each later frame (timed).
 
@@ -333,6 +339,8 @@ def run_tracker(tracker: TrackerAdapter, frames, init_box) -> RunResult:
         The sequence's frames.
     init_box : array_like
         (x, y, w, h) on the first frame.
+    interval : float, optional
+        Seconds between frames, when known (:meth:`TrackerAdapter.update`).
 
     Returns
     -------
@@ -357,7 +365,7 @@ def run_tracker(tracker: TrackerAdapter, frames, init_box) -> RunResult:
     boxes, oks, times = [init_box], [True], []
     for frame in it:
         t0 = time.perf_counter()
-        box, ok = tracker.update(frame)
+        box, ok = tracker.update(frame, interval)
         times.append(time.perf_counter() - t0)
         box = np.asarray(box, dtype=float).reshape(4)
         # no box returned: keep the last one
@@ -373,7 +381,8 @@ def evaluate_sequence(seq: Sequence, tracker: TrackerAdapter) -> tuple[SequenceS
     Parameters
     ----------
     seq : Sequence
-        The sequence, initialised with its first GT box.
+        The sequence, initialised with its first GT box; its frame rate, when known, gives the
+        tracker the frames' interval.
     tracker : TrackerAdapter
         A fresh tracker.
 
@@ -385,7 +394,8 @@ def evaluate_sequence(seq: Sequence, tracker: TrackerAdapter) -> tuple[SequenceS
         The run.
 
     """
-    run = run_tracker(tracker, seq.frames(), seq.gt_boxes[0])
+    interval = None if seq.frame_rate is None else 1.0 / seq.frame_rate
+    run = run_tracker(tracker, seq.frames(), seq.gt_boxes[0], interval)
     return score_sequence(run.boxes, seq.gt_boxes, seq.name, fps=run.fps), run
 
 

@@ -876,15 +876,19 @@ class TrackingPipeline:
     def _track(self, target: _Target, frame, t: int, prior, gyro_box, gyro_reason) -> FrameResult:
         """One target's update into the frame at ``t`` (under the track lock)."""
         start = time.perf_counter()
+        # the models learn for the time since the window's frame, not for one frame
+        # (docs/decisions.md#frame-interval-learning)
+        t_ref = target.window[0]
+        interval = (t - t_ref) / 1e9 if t > t_ref else None
         try:
             try:
-                result = self._update(target, frame, prior)
+                result = self._update(target, frame, prior, interval)
             except ValueError as exc:
                 if prior is None:
                     raise
                 gyro_reason = f'gyro prior not usable ({exc}); tracked without it'
                 prior, gyro_box = None, None
-                result = self._update(target, frame, None)
+                result = self._update(target, frame, None, interval)
         except Abandoned as exc:
             return self._abandon(target, t, exc)
         ms = (time.perf_counter() - start) * 1e3
@@ -897,7 +901,7 @@ class TrackingPipeline:
         """Return a tracker of the configured parameters, threaded when the pipeline is live."""
         return IemdTracker(self._cfg.tracker, threads=self._live)
 
-    def _update(self, target: _Target, frame, prior):
+    def _update(self, target: _Target, frame, prior, interval):
         """
         Return the tracker's update, under the watchdog when live.
 
@@ -905,9 +909,10 @@ class TrackingPipeline:
         """
         tracker = target.tracker
         if not self._live:
-            return tracker.update(frame, prior=prior)
+            return tracker.update(frame, prior=prior, interval=interval)
         return self._watchdog.run(
-            lambda: tracker.update(frame, prior=prior), self._cfg.watchdog_ms / 1e3
+            lambda: tracker.update(frame, prior=prior, interval=interval),
+            self._cfg.watchdog_ms / 1e3,
         )
 
     def _abandon(self, target: _Target, t: int, exc: Abandoned) -> FrameResult:

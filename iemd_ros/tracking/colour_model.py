@@ -56,6 +56,7 @@ from typing import Callable
 
 import cv2
 from iemd_ros.tracking.appearance import warp_window, window_axes
+from iemd_ros.tracking.memory import rate_over
 import numba
 import numpy as np
 
@@ -138,7 +139,9 @@ class ColourModel:
         self._scores = None
         self.estimate(frame, center, size, angle)
 
-    def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
+    def update(
+        self, frame: np.ndarray, center, size, angle: float = 0.0, frames: float = 1.0
+    ) -> None:
         """
         Blend in the histograms at the tracked window.
 
@@ -152,11 +155,18 @@ class ColourModel:
             (w, h) window size, image pixels.
         angle : float, optional
             The window's turn, radians.
+        frames : float, optional
+            The reference frames the frame stands for: the blend is at
+            :func:`~iemd_ros.tracking.memory.rate_over` of ``learning_rate``.
 
         """
         target, surroundings = self._histograms(frame, center, size, angle)
         self._target, self._surroundings, self._beta = _blend(
-            self._target, self._surroundings, target, surroundings, self.learning_rate
+            self._target,
+            self._surroundings,
+            target,
+            surroundings,
+            rate_over(self.learning_rate, frames),
         )
         self._scores = None
 

@@ -279,6 +279,14 @@ class TrackerConfig:
         range=(1e-4, 10.0),
         eq='eq. (reconstructed template)',
     )
+    reference_rate: float = param(
+        30.0,
+        "frame rate the models' per-frame learning rates hold for; a frame of known "
+        'interval learns as interval x this many frames',
+        unit='Hz',
+        range=(1.0, 1000.0),
+        decision='frame-interval-learning',
+    )
 
     def __post_init__(self):
         coerce(self, 'tracker.')

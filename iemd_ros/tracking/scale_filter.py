@@ -47,6 +47,7 @@ from __future__ import annotations
 import cv2
 from iemd_ros.tracking import features
 from iemd_ros.tracking.correlation_filter import sample_region
+from iemd_ros.tracking.memory import rate_over
 import numpy as np
 
 __all__ = ['ScaleFilter']
@@ -131,19 +132,23 @@ class ScaleFilter:
         )
         return float(np.clip(scale, bounds[0], bounds[1]))
 
-    def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
+    def update(
+        self, frame: np.ndarray, center, size, angle: float = 0.0, frames: float = 1.0
+    ) -> None:
         """
         Learn on the scale samples of the window (``center``, ``size``, ``angle``) of ``frame``.
 
-        See eqs. 5-6, 21.
+        See eqs. 5-6, 21; the frame stands for ``frames`` reference frames
+        (:func:`~iemd_ros.tracking.memory.rate_over`).
         """
         x = self._sample(frame, center, size, angle)
         denominator = np.real(self._correlation_f(x, x))
         if self.template is None:
             self.template, self.denominator = x, denominator
         else:
-            self.template = (1 - LEARNING_RATE) * self.template + LEARNING_RATE * x
-            self.denominator = (1 - LEARNING_RATE) * self.denominator + LEARNING_RATE * denominator
+            rate = rate_over(LEARNING_RATE, frames)
+            self.template = (1 - rate) * self.template + rate * x
+            self.denominator = (1 - rate) * self.denominator + rate * denominator
 
     def _correlation_f(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """

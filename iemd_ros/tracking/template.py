@@ -136,8 +136,9 @@ class TemplateDictionary:
             (Th, Tw) tracked template I_k.
         emd : float
             Its EMD D*_k.
-        index : int
-            Frame index k.
+        index : float
+            The frame's time k in reference frames (``TrackerConfig.reference_rate``): the
+            frame index at that rate.
 
         Returns
         -------

@@ -68,6 +68,7 @@ from iemd_ros.tracking.candidate import CandidateModel, SearchContext, TargetMod
 from iemd_ros.tracking.colour_model import ColourModel
 from iemd_ros.tracking.config import ScaleEstimator, TrackerConfig
 from iemd_ros.tracking.flow import window_flow
+from iemd_ros.tracking.memory import rate_over
 from iemd_ros.tracking.scale_filter import ScaleFilter
 from iemd_ros.tracking.template import TemplateDictionary
 from iemd_ros.tracking.translation_filter import TranslationFilter
@@ -213,7 +214,7 @@ class IemdTracker:
         # orientation of the tracked window (radians), only ever changed by priors
         self._angle = 0.0
         self._background_emd = np.inf
-        self._frame_index = 0
+        self._clock = 0.0  # time since init, in reference frames (TrackerConfig.reference_rate)
         self._lost = False
         self._confidence = None
         self._peak_apce_sums, self._peak_apce_count, self._peak_apce = np.zeros(2), 0, None
@@ -275,7 +276,7 @@ class IemdTracker:
             )
         # the colour model has estimated on this frame (not on a grey frame)
         self._colour_now = False
-        self._frame_index = 0
+        self._clock = 0.0
         self._lost = False
         # running mean of the filter's response at the window over frames that learned
         self._confidence = None
@@ -291,7 +292,7 @@ class IemdTracker:
         self._anchor = None
         self._prediction = None  # this frame's predicted centre
 
-    def update(self, frame: np.ndarray, prior=None) -> TrackResult:
+    def update(self, frame: np.ndarray, prior=None, interval: float | None = None) -> TrackResult:
         """
         Track the target into ``frame``.
 
@@ -303,6 +304,10 @@ class IemdTracker:
         prior : array_like (3, 3), optional
             Homography taking the previous frame's pixels to this frame's (the gyro's ``K R^T
             K^-1``, eq. 23): the prediction moves, turns and scales with it.
+        interval : float, optional
+            Seconds since the previous frame (from their stamps): the models learn from this frame
+            as from ``interval x reference_rate`` frames (:mod:`~iemd_ros.tracking.memory`).
+            None: one frame at the reference rate.
 
         Returns
         -------
@@ -313,13 +318,17 @@ class IemdTracker:
         Raises
         ------
         ValueError
-            For a bad frame or prior (non-finite, singular, or mapping the window to infinity); the
-            tracker's state is then unchanged.
+            For a bad frame, prior (non-finite, singular, or mapping the window to infinity) or
+            interval (not finite and positive); the tracker's state is then unchanged.
 
         """
         if self._center is None:
             raise RuntimeError('IemdTracker.update() called before init()')
         _check_frame(frame)
+        # the reference frames this frame stands for, as its models learn from it
+        frames = (
+            1.0 if interval is None else _check_interval(interval) * self.config.reference_rate
+        )
         center, size, angle, anchor = (
             self._center.copy(),
             self._size.copy(),
@@ -357,7 +366,7 @@ class IemdTracker:
                 window_flow, self._previous, grey, box, prior, cfg.flow_max_error
             )
         self._previous = grey if cfg.flow_start else None
-        self._frame_index += 1
+        self._clock += frames
         self._anchor, self._prediction = anchor, center
         predicted = _box(center, size, angle)
         # the prior moved the window out of view: keep its place, search only the frame
@@ -432,7 +441,7 @@ class IemdTracker:
                 self._peak_apce_count += 1
             # with threads the result goes back now and the models learn meanwhile
             self._learning = self._learner.submit(
-                self._learn, frame, final, best.confidence, new_center, new_size, angle
+                self._learn, frame, final, best.confidence, new_center, new_size, angle, frames
             )
         return TrackResult(
             box=_box(new_center, new_size, angle),
@@ -703,27 +712,30 @@ class IemdTracker:
             return _Descent(model=best.model, emd=best.emd), scale
         return self._search_scale(best, bounds)
 
-    def _learn(self, frame, final: _Descent, confidence, center, size, angle) -> None:
+    def _learn(self, frame, final: _Descent, confidence, center, size, angle, frames) -> None:
         """
-        Every model learns the window of a tracked frame.
+        Every model learns the window of a tracked frame, as ``frames`` reference frames.
 
         The response's running mean, both filters, the colour histograms and the template
         dictionary (Algorithm 2).
         """
         if confidence is not None:
+            rate = rate_over(CONFIDENCE_RATE, frames)
             self._confidence = (
                 confidence
                 if self._confidence is None
-                else ((1.0 - CONFIDENCE_RATE) * self._confidence + CONFIDENCE_RATE * confidence)
+                else ((1.0 - rate) * self._confidence + rate * confidence)
             )
         # The scale filter and the colour model learn on the workers beside the filter.
         learners = [self._scale_filter.update] if self._scale_filter is not None else []
         learners += [self._colour_model.update] if self._colour_now else []
-        jobs = [self._workers.submit(learn, frame, center, size, angle) for learn in learners]
+        jobs = [
+            self._workers.submit(learn, frame, center, size, angle, frames) for learn in learners
+        ]
         if self._translation_filter is not None:
-            self._translation_filter.update(frame, center, size, angle)
+            self._translation_filter.update(frame, center, size, angle, frames)
         if self.config.update_templates and self.dictionary.observe(
-            final.model.template, final.emd, self._frame_index
+            final.model.template, final.emd, self._clock
         ):
             self._refresh_target()
         for job in jobs:
@@ -1153,6 +1165,14 @@ def _check_box(box, shape):
     TARGET_SIDE.check('box w', w, shape[1])
     TARGET_SIDE.check('box h', h, shape[0])
     return x, y, w, h
+
+
+def _check_interval(interval) -> float:
+    """Return ``interval`` (s) as a float; ValueError unless it is finite and positive."""
+    value = float(interval)
+    if not (np.isfinite(value) and value > 0.0):
+        raise ValueError(f'interval must be a finite number of seconds > 0, got {interval!r}')
+    return value
 
 
 def _check_prior(prior) -> np.ndarray:

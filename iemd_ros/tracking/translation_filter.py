@@ -76,6 +76,7 @@ from iemd_ros.tracking.correlation_filter import (
     sample_region,
     SubCellPeak,
 )
+from iemd_ros.tracking.memory import penalty_over
 import numba
 import numpy as np
 import scipy.fft as sfft
@@ -454,12 +455,15 @@ class TranslationFilter:
         return {'peak': self.response_peak, 'apce': apce(self._response[0])}
 
     # ------------------------------------------------------------------ learning
-    def update(self, frame: np.ndarray, center, size, angle: float = 0.0) -> None:
+    def update(
+        self, frame: np.ndarray, center, size, angle: float = 0.0, frames: float = 1.0
+    ) -> None:
         """
         Learn on the window (``center``, ``size``, ``angle``) of ``frame``.
 
         The detection sample shifted there when ``frame`` is the one just estimated on at this
-        scale and turn, else a new sample (STRCF, eqs. 3-10).
+        scale and turn, else a new sample (STRCF, eqs. 3-10); the temporal term's weight is
+        :func:`~iemd_ros.tracking.memory.penalty_over` ``frames`` reference frames.
         """
         scale = self._scale(size)
         det, self._detection = self._detection, None
@@ -479,7 +483,7 @@ class TranslationFilter:
             xf = det.zf * (phase_y[:, None] * phase_x[None, :])[None]
         else:
             xf = self._spectrum(frame, self._position(center, angle), scale, angle)
-        self.f = self._admm(xf, self.f)
+        self.f = self._admm(xf, self.f, mu=penalty_over(MU, frames))
 
     def _admm(
         self,
