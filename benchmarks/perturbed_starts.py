@@ -225,7 +225,8 @@ def main() -> None:
         type=int,
         default=1,
         help='every N-th frame only, as a camera at 1/N of the rate; iEMD is told the interval, '
-        'N frames at --frame-rate or, unknown, at its reference rate (default: 1)',
+        'N frames at --frame-rate or, unknown, at the default reference_rate '
+        '(default: 1)',
     )
     parser.add_argument('--jobs', type=int, default=2)
     parser.add_argument(

@@ -126,6 +126,9 @@ def test_a_frame_rate_gives_the_tracker_the_frames_interval(tmp_path, monkeypatc
     argv = [str(root), '--trackers', 'oracle', '--out', str(tmp_path / 'out'), '--jobs', '1']
     assert main(argv + ['--frame-rate', '12.5']) == 0
     assert _Oracle.intervals == [0.08] * 5
+    assert json.loads((tmp_path / 'out' / 'results.json').read_text())['frame_rates'] == {
+        'Toy': 12.5
+    }
     _Oracle.intervals.clear()
     assert main(argv) == 0  # the OTB layout records no rate
     assert _Oracle.intervals == [None] * 5

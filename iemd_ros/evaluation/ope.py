@@ -839,6 +839,7 @@ def evaluate(
         ),
         'sequences': [s.name for s in sequences],
         'groups': {s.name: s.group for s in sequences},
+        'frame_rates': {s.name: s.frame_rate for s in sequences},  # Hz; None: unknown
         'ground_truth': {
             s.name: [[None if np.isnan(v) else v for v in box] for box in s.gt_boxes.tolist()]
             for s in sequences
