@@ -100,6 +100,10 @@ SCALES = tuple((0.0, 0.0, s, 0.0) for s in (0.8, 0.9, 1.1, 1.2))
 SEGMENTS = 20  # OTB's temporal robustness evaluation: starts at 20 evenly spaced frames
 TEMPORAL = tuple((0.0, 0.0, 1.0, k / SEGMENTS) for k in range(SEGMENTS))
 START_SETS = {'diagonal': DIAGONALS, 'sre': DIAGONALS + AXES + SCALES, 'tre': TEMPORAL}
+# the options a saved run records, and the value a file saved before an option existed ran with
+SETTINGS = {
+    'starts': None, 'shift': None, 'resolution': 1.0, 'mono': False, 'every': 1, 'frame_rate': None
+}
 
 
 def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: float) -> np.ndarray:
@@ -244,18 +248,12 @@ def main() -> None:
         parser.error(f'--frame-rate must be > 0, got {args.frame_rate}')
     rate = args.frame_rate or (None if args.every == 1 else TrackerConfig().reference_rate)
     interval = None if rate is None else args.every / rate
+    settings = {key: getattr(args, key) for key in SETTINGS}
     names = sequence_names(args.sequences)
     if args.split is not None:
         names = [n for n in names if n in split_names(args.split)]
     # checked before any run: a saved run without these sequences fails at once
-    reference = (
-        None
-        if args.against is None
-        else _load_reference(
-            args.against, args.starts, args.shift, args.resolution, args.mono, args.every,
-            args.frame_rate, names,
-        )
-    )
+    reference = None if args.against is None else _load_reference(args.against, settings, names)
     digest = _tracker_digest()
     # Checked here, before any run: a bad key or peer fails at once with its own message.
     runs = [
@@ -330,12 +328,7 @@ def main() -> None:
         args.save.write_text(
             json.dumps(
                 {
-                    'starts': args.starts,
-                    'shift': args.shift,
-                    'resolution': args.resolution,
-                    'mono': args.mono,
-                    'every': args.every,
-                    'frame_rate': args.frame_rate,
+                    **settings,
                     'tracker_sources': digest,
                     'saved': datetime.datetime.now().isoformat(timespec='seconds'),
                     'runs': {
@@ -369,36 +362,28 @@ def _tracker_digest() -> str:
     return h.hexdigest()[:12]
 
 
-def _load_reference(
-    path: Path, starts: str, shift: float, resolution: float, mono: bool, every: int, frame_rate,
-    names,
-) -> tuple[str, np.ndarray, str]:
+def _load_reference(path: Path, settings: dict, names) -> tuple[str, np.ndarray, str]:
     """
     (label, AO % per sequence of ``names`` and start, source) of the first tracker saved by --save.
 
     Its source: the digest of the tracker sources it ran and when, as far as the file records them.
 
-    SystemExit with one line for a file that is not such a run, or one of other starts, shift,
-    resolution, frames or frame rate (a file without them is at full resolution, in the frames'
-    own colour, every frame, of an unknown rate), or without a run of one of ``names``.
+    SystemExit with one line for a file that is not such a run, or one run with other
+    ``settings`` (the options of :data:`SETTINGS`; a file without one ran with its default), or
+    without a run of one of ``names``.
     """
     try:
         saved = json.loads(path.read_text())
         label, runs = next(iter(saved['runs'].items()))
     except (OSError, ValueError, KeyError, StopIteration, AttributeError) as exc:
         raise SystemExit(f'--against {path}: not a run saved by --save ({exc})') from None
-    saved_as = (
-        saved.get('starts'), saved.get('shift'), saved.get('resolution', 1.0),
-        saved.get('mono', False), saved.get('every', 1), saved.get('frame_rate'),
-    )
-    if saved_as != (starts, shift, resolution, mono, every, frame_rate):
-        raise SystemExit(
-            f'--against {path}: saved with --starts {saved_as[0]} --shift {saved_as[1]} '
-            f'--resolution {saved_as[2]}{" --mono" * saved_as[3]} --every {saved_as[4]} '
-            f'--frame-rate {saved_as[5]}, this run uses --starts {starts} --shift {shift} '
-            f'--resolution {resolution}{" --mono" * mono} --every {every} --frame-rate '
-            f'{frame_rate}'
-        )
+    differ = [
+        f'--{key.replace("_", "-")} {saved.get(key, default)} (this run: {settings[key]})'
+        for key, default in SETTINGS.items()
+        if saved.get(key, default) != settings[key]
+    ]
+    if differ:
+        raise SystemExit(f'--against {path}: saved with {", ".join(differ)}')
     missing = [n for n in names if n not in runs]
     if missing:
         raise SystemExit(f'--against {path}: no run of {", ".join(missing)}')
