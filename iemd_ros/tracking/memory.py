@@ -40,7 +40,7 @@ variance ``1 / mu`` per frame on the filter, becomes ``mu / frames``.
 """
 from __future__ import annotations
 
-__all__ = ['rate_over', 'penalty_over']
+__all__ = ['rate_over', 'running_average', 'penalty_over']
 
 
 def rate_over(rate: float, frames: float) -> float:
@@ -63,6 +63,29 @@ def rate_over(rate: float, frames: float) -> float:
     if frames == 1.0:
         return rate
     return 1.0 - (1.0 - rate) ** frames
+
+
+def running_average(old, new, rate: float, frames: float = 1.0):
+    """
+    Return a running average at ``rate`` per reference frame after ``new`` over ``frames`` of them.
+
+    Parameters
+    ----------
+    old, new : float or ndarray
+        The average so far and the frame's value.
+    rate : float
+        The rate per reference frame, in (0, 1].
+    frames : float, optional
+        The frame's interval in reference frame intervals, > 0.
+
+    Returns
+    -------
+    float or ndarray
+        ``(1 - r) old + r new`` with ``r`` = :func:`rate_over` ``(rate, frames)``.
+
+    """
+    r = rate_over(rate, frames)
+    return (1 - r) * old + r * new
 
 
 def penalty_over(mu: float, frames: float) -> float:

@@ -47,7 +47,7 @@ from __future__ import annotations
 import cv2
 from iemd_ros.tracking import features
 from iemd_ros.tracking.correlation_filter import sample_region
-from iemd_ros.tracking.memory import rate_over
+from iemd_ros.tracking.memory import running_average
 import numpy as np
 
 __all__ = ['ScaleFilter']
@@ -139,16 +139,17 @@ class ScaleFilter:
         Learn on the scale samples of the window (``center``, ``size``, ``angle``) of ``frame``.
 
         See eqs. 5-6, 21; the frame stands for ``frames`` reference frames
-        (:func:`~iemd_ros.tracking.memory.rate_over`).
+        (:func:`~iemd_ros.tracking.memory.running_average`).
         """
         x = self._sample(frame, center, size, angle)
         denominator = np.real(self._correlation_f(x, x))
         if self.template is None:
             self.template, self.denominator = x, denominator
         else:
-            rate = rate_over(LEARNING_RATE, frames)
-            self.template = (1 - rate) * self.template + rate * x
-            self.denominator = (1 - rate) * self.denominator + rate * denominator
+            self.template = running_average(self.template, x, LEARNING_RATE, frames)
+            self.denominator = running_average(
+                self.denominator, denominator, LEARNING_RATE, frames
+            )
 
     def _correlation_f(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """

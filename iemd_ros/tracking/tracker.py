@@ -68,7 +68,7 @@ from iemd_ros.tracking.candidate import CandidateModel, SearchContext, TargetMod
 from iemd_ros.tracking.colour_model import ColourModel
 from iemd_ros.tracking.config import ScaleEstimator, TrackerConfig
 from iemd_ros.tracking.flow import window_flow
-from iemd_ros.tracking.memory import rate_over
+from iemd_ros.tracking.memory import running_average
 from iemd_ros.tracking.scale_filter import ScaleFilter
 from iemd_ros.tracking.template import TemplateDictionary
 from iemd_ros.tracking.translation_filter import TranslationFilter
@@ -720,11 +720,10 @@ class IemdTracker:
         dictionary (Algorithm 2).
         """
         if confidence is not None:
-            rate = rate_over(CONFIDENCE_RATE, frames)
             self._confidence = (
                 confidence
                 if self._confidence is None
-                else ((1.0 - rate) * self._confidence + rate * confidence)
+                else running_average(self._confidence, confidence, CONFIDENCE_RATE, frames)
             )
         # The scale filter and the colour model learn on the workers beside the filter.
         learners = [self._scale_filter.update] if self._scale_filter is not None else []
