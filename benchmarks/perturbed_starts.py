@@ -79,6 +79,7 @@ from pathlib import Path
 import cv2
 from iemd_ros import TrackerConfig, tracking
 from iemd_ros.common.boxes import box_centre, centre_box
+from iemd_ros.common.cli import positive_float
 from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation.metrics import paired_difference, score_sequence, valid_boxes
 from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
@@ -219,7 +220,7 @@ def main() -> None:
     )
     parser.add_argument(
         '--frame-rate',
-        type=float,
+        type=positive_float,
         default=None,
         metavar='HZ',
         help="the sequences' own frame rate, which iEMD is told (default: unknown)",
@@ -244,8 +245,6 @@ def main() -> None:
         parser.error(f'--resolution must be in (0, 1], got {args.resolution}')
     if args.every < 1:
         parser.error(f'--every must be >= 1, got {args.every}')
-    if args.frame_rate is not None and not args.frame_rate > 0:
-        parser.error(f'--frame-rate must be > 0, got {args.frame_rate}')
     rate = args.frame_rate or (None if args.every == 1 else TrackerConfig().reference_rate)
     interval = None if rate is None else args.every / rate
     settings = {key: getattr(args, key) for key in SETTINGS}

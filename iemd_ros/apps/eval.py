@@ -54,12 +54,11 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import math
 from pathlib import Path
 import sys
 import time
 
-from iemd_ros.common.cli import cli_main, CliParser
+from iemd_ros.common.cli import cli_main, CliParser, positive_float
 from iemd_ros.common.parallel import add_worker_arguments, Workers
 from iemd_ros.evaluation.ope import (
     collect_sequences,
@@ -101,16 +100,6 @@ def _positive_int(text: str) -> int:
     return v
 
 
-def _positive_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f'must be a finite number > 0, got {text!r}')
-    return v
-
-
 def build_parser() -> argparse.ArgumentParser:
     p = CliParser(
         prog='iemd-eval',
@@ -148,7 +137,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         '--frame-rate',
-        type=_positive_float,
+        type=positive_float,
         default=None,
         metavar='HZ',
         help="the sequences' frame rate, which the OTB layout does not record: iEMD's models "

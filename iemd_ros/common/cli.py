@@ -36,9 +36,10 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Callable
+import math
 import sys
 
-__all__ = ['CliParser', 'UsageError', 'cli_main', 'one_line', 'split_ros_args']
+__all__ = ['CliParser', 'UsageError', 'cli_main', 'one_line', 'positive_float', 'split_ros_args']
 
 
 class UsageError(Exception):
@@ -78,6 +79,35 @@ class CliParser(argparse.ArgumentParser):
 
         """
         raise UsageError(message)
+
+
+def positive_float(text: str) -> float:
+    """
+    Return ``text`` as a finite number > 0: an argparse ``type``.
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    float
+        Its value.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        For text that is not a number, or a number not finite and > 0.
+
+    """
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
+    if not (math.isfinite(v) and v > 0):
+        raise argparse.ArgumentTypeError(f'must be a finite number > 0, got {text!r}')
+    return v
 
 
 def one_line(exc: BaseException) -> str:
