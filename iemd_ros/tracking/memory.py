@@ -65,7 +65,7 @@ def rate_over(rate: float, frames: float) -> float:
     return 1.0 - (1.0 - rate) ** frames
 
 
-def running_average(old, new, rate: float, frames: float = 1.0):
+def running_average(old, new, rate: float, frames: float):
     """
     Return a running average at ``rate`` per reference frame after ``new`` over ``frames`` of them.
 
@@ -75,7 +75,7 @@ def running_average(old, new, rate: float, frames: float = 1.0):
         The average so far and the frame's value.
     rate : float
         The rate per reference frame, in (0, 1].
-    frames : float, optional
+    frames : float
         The frame's interval in reference frame intervals, > 0.
 
     Returns
