@@ -32,13 +32,22 @@ iemd-eval end to end (iemd_ros.evaluation.ope).
 
 Protocol wiring on synthetic data, CLI on real OTB frames.
 """
+import argparse
 import json
 from pathlib import Path
 
 import cv2
-from helpers import cli_error, node_parameter_file, PNG_SIGNATURE, run_module
+from helpers import (
+    cli_error,
+    node_parameter_file,
+    PNG_SIGNATURE,
+    REPO,
+    run_module,
+    run_python,
+)
 from iemd_ros import TrackerConfig
 from iemd_ros.apps.eval import main
+from iemd_ros.common.cli import positive_float
 from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation import ope as evaluation
 from iemd_ros.evaluation.ope import (
@@ -280,6 +289,25 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
 )
 def test_bad_arguments_exit_2_one_line(argv, match, capsys):
     assert match in cli_error(main, argv, capsys, 'iemd-eval: error:')
+
+
+@pytest.mark.parametrize('text', ['inf', '-inf', 'nan', '0', '-2', 'fast', ''])
+def test_positive_float_refuses_what_is_not_a_finite_number_above_zero(text):
+    with pytest.raises(argparse.ArgumentTypeError):
+        positive_float(text)
+
+
+def test_positive_float_reads_a_number():
+    assert positive_float('12.5') == 12.5
+    assert positive_float('1e-3') == 0.001
+
+
+def test_perturbed_starts_refuses_an_infinite_frame_rate_in_one_line():
+    script = REPO / 'benchmarks' / 'perturbed_starts.py'
+    proc = run_python(str(script), '--frame-rate', 'inf', timeout=60)
+    assert proc.returncode == 2
+    assert 'Traceback' not in proc.stderr
+    assert "argument --frame-rate: must be a finite number > 0, got 'inf'" in proc.stderr
 
 
 def test_unknown_sequence_exits_2_one_line(tmp_path, capsys):

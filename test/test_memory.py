@@ -65,6 +65,15 @@ def test_a_rate_over_frames_is_that_many_frames_in_turn():
     assert memory.penalty_over(15.0, 3.0) == 5.0
 
 
+def test_a_running_average_over_frames_is_that_many_frames_in_turn():
+    old, new, eta = np.array([4.0, -2.0]), np.array([1.0, 3.0]), 0.3
+    # by hand: 0.7 x 4 + 0.3 x 1 = 3.1
+    assert memory.running_average(4.0, 1.0, eta, 1.0) == pytest.approx(3.1)
+    twice = memory.running_average(memory.running_average(old, new, eta, 1.0), new, eta, 1.0)
+    np.testing.assert_allclose(memory.running_average(old, new, eta, 2.0), twice)
+    np.testing.assert_array_equal(old, [4.0, -2.0])  # the average so far is not written into
+
+
 def _double_twice_once(model):
     """Return a frame and three ``model()`` that learned it: as two frames, twice, once."""
     frame0, frame1 = _colour(1), shifted(_colour(5), 3.0, -2.0)
