@@ -42,7 +42,7 @@ import argparse
 from pathlib import Path
 import sys
 
-from iemd_ros.common.cli import cli_main, CliParser, split_ros_args
+from iemd_ros.common.cli import cli_main, CliParser, positive_float, split_ros_args
 from iemd_ros.ros.play import parse_remaps, play
 
 __all__ = ['main', 'build_parser']
@@ -51,7 +51,9 @@ __all__ = ['main', 'build_parser']
 def build_parser() -> argparse.ArgumentParser:
     p = CliParser(prog='iemd-play', description=__doc__.split('\n\n')[0])
     p.add_argument('bag', type=Path, help='rosbag2 folder (sqlite3/mcap) or ROS 1 .bag file')
-    p.add_argument('--rate', type=float, default=1.0, help='playback rate factor (default 1.0)')
+    p.add_argument(
+        '--rate', type=positive_float, default=1.0, help='playback rate factor (default 1.0)'
+    )
     p.add_argument('--topics', nargs='+', default=None, help='play only these topics')
     p.add_argument(
         '--remap', action='append', default=[], metavar='FROM:=TO', help='publish FROM under TO'

@@ -50,6 +50,7 @@ with the log time of each message, for nodes with ``use_sim_time``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+import math
 import sys
 import time
 
@@ -111,7 +112,7 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
     bag : path
         rosbag2 folder or ROS 1 ``.bag``.
     rate : float
-        Playback rate factor (> 0).
+        Playback rate factor (finite, > 0).
     topics : list of str, optional
         Only these bag topics (default all).
     remap : dict, optional
@@ -143,8 +144,8 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
     import rclpy
     from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-    if not rate > 0:
-        raise ValueError(f'--rate must be > 0, got {rate}')
+    if not (math.isfinite(rate) and rate > 0):
+        raise ValueError(f'--rate must be a finite number > 0, got {rate}')
     if qos_depth < 1:
         raise ValueError(f'--qos-depth must be >= 1, got {qos_depth}')
     remap = dict(remap or {})
