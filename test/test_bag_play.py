@@ -292,14 +292,21 @@ def test_cli_bad_input(tmp_path, capsys):
         ([str(tmp_path / 'missing')], 'does not exist'),
         ([str(tmp_path), '--rate', '0'], 'must be a finite number > 0'),
         ([str(tmp_path), '--rate', 'inf'], 'must be a finite number > 0'),
+        ([str(tmp_path), '--delay', 'inf'], 'must be a finite number >= 0'),
+        ([str(tmp_path), '--delay', '-1'], 'must be a finite number >= 0'),
+        ([str(tmp_path), '--wait-subscribers', 'nan'], 'must be a finite number >= 0'),
         ([str(tmp_path), '--remap', 'a'], 'FROM:=TO'),
     ]:
         assert text in cli_error(main, argv, capsys, 'iemd-play: error:')
     seq = shaky_sequence(2, render=True)
     make_bag(seq, tmp_path / 'b')
     assert main([str(tmp_path / 'b'), '--topics', '/nope']) == 2
-    # the library call refuses what the command line refuses, before opening the bag
-    for rate in (0.0, -1.0, float('inf'), float('nan')):
-        with pytest.raises(ValueError, match='finite number > 0'):
-            play(tmp_path / 'b', rate=rate)
     assert 'not in the bag' in capsys.readouterr().err
+    # the library call refuses what the command line refuses, before playing anything
+    for rate in (0.0, -1.0, float('inf'), float('nan')):
+        with pytest.raises(ValueError, match='--rate must be a finite number > 0'):
+            play(tmp_path / 'b', rate=rate)
+    for kw in ('delay_s', 'wait_subscribers_s'):
+        for seconds in (-1.0, float('inf'), float('nan')):
+            with pytest.raises(ValueError, match='must be a finite number >= 0'):
+                play(tmp_path / 'b', **{kw: seconds})

@@ -42,7 +42,13 @@ import argparse
 from pathlib import Path
 import sys
 
-from iemd_ros.common.cli import cli_main, CliParser, positive_float, split_ros_args
+from iemd_ros.common.cli import (
+    cli_main,
+    CliParser,
+    non_negative_float,
+    positive_float,
+    split_ros_args,
+)
 from iemd_ros.ros.play import parse_remaps, play
 
 __all__ = ['main', 'build_parser']
@@ -59,11 +65,15 @@ def build_parser() -> argparse.ArgumentParser:
         '--remap', action='append', default=[], metavar='FROM:=TO', help='publish FROM under TO'
     )
     p.add_argument(
-        '--delay', type=float, default=0.0, metavar='S', help='sleep S seconds before playing'
+        '--delay',
+        type=non_negative_float,
+        default=0.0,
+        metavar='S',
+        help='sleep S seconds before playing',
     )
     p.add_argument(
         '--wait-subscribers',
-        type=float,
+        type=non_negative_float,
         default=0.0,
         metavar='S',
         help='wait up to S seconds until every topic has a subscriber',

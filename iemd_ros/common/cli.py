@@ -39,7 +39,15 @@ from collections.abc import Callable
 import math
 import sys
 
-__all__ = ['CliParser', 'UsageError', 'cli_main', 'one_line', 'positive_float', 'split_ros_args']
+__all__ = [
+    'CliParser',
+    'UsageError',
+    'cli_main',
+    'non_negative_float',
+    'one_line',
+    'positive_float',
+    'split_ros_args',
+]
 
 
 class UsageError(Exception):
@@ -101,12 +109,41 @@ def positive_float(text: str) -> float:
         For text that is not a number, or a number not finite and > 0.
 
     """
+    return _finite_float(text, 0.0, strict=True)
+
+
+def non_negative_float(text: str) -> float:
+    """
+    Return ``text`` as a finite number >= 0: an argparse ``type``.
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    float
+        Its value.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        For text that is not a number, or a number not finite and >= 0.
+
+    """
+    return _finite_float(text, 0.0, strict=False)
+
+
+def _finite_float(text: str, least: float, strict: bool) -> float:
+    """Return ``text`` as a finite number above ``least`` (or equal to it unless ``strict``)."""
     try:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f'must be a finite number > 0, got {text!r}')
+    if not (math.isfinite(v) and (v > least if strict else v >= least)):
+        bound = f'> {least:g}' if strict else f'>= {least:g}'
+        raise argparse.ArgumentTypeError(f'must be a finite number {bound}, got {text!r}')
     return v
 
 

@@ -146,6 +146,9 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
 
     if not (math.isfinite(rate) and rate > 0):
         raise ValueError(f'--rate must be a finite number > 0, got {rate}')
+    for name, seconds in (('--delay', delay_s), ('--wait-subscribers', wait_subscribers_s)):
+        if not (math.isfinite(seconds) and seconds >= 0):
+            raise ValueError(f'{name} must be a finite number >= 0, got {seconds}')
     if qos_depth < 1:
         raise ValueError(f'--qos-depth must be >= 1, got {qos_depth}')
     remap = dict(remap or {})
