@@ -47,7 +47,7 @@ from helpers import (
 )
 from iemd_ros import TrackerConfig
 from iemd_ros.apps.eval import main
-from iemd_ros.common.cli import positive_float
+from iemd_ros.common.cli import non_negative_float, positive_float
 from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation import ope as evaluation
 from iemd_ros.evaluation.ope import (
@@ -99,7 +99,7 @@ class _Oracle:
 
 def test_protocol_with_oracle_tracker(tmp_path, monkeypatch, capsys):
     root, gt = _synthetic_root(tmp_path)
-    _Oracle.gt = gt
+    monkeypatch.setattr(_Oracle, 'gt', gt, raising=False)
     monkeypatch.setitem(evaluation.TRACKERS, 'oracle', _Oracle)
     out = tmp_path / 'out'
     assert (
@@ -129,7 +129,7 @@ def test_protocol_with_oracle_tracker(tmp_path, monkeypatch, capsys):
 
 def test_a_frame_rate_gives_the_tracker_the_frames_interval(tmp_path, monkeypatch):
     root, gt = _synthetic_root(tmp_path)
-    monkeypatch.setattr(_Oracle, 'gt', gt)
+    monkeypatch.setattr(_Oracle, 'gt', gt, raising=False)
     monkeypatch.setattr(_Oracle, 'intervals', [])
     monkeypatch.setitem(evaluation.TRACKERS, 'oracle', _Oracle)
     argv = [str(root), '--trackers', 'oracle', '--out', str(tmp_path / 'out'), '--jobs', '1']
@@ -302,6 +302,17 @@ def test_positive_float_reads_a_number():
     assert positive_float('1e-3') == 0.001
 
 
+@pytest.mark.parametrize('text', ['inf', '-inf', 'nan', '-1e-9', '-2', 'soon', ''])
+def test_non_negative_float_refuses_what_is_not_a_finite_number_from_zero(text):
+    with pytest.raises(argparse.ArgumentTypeError):
+        non_negative_float(text)
+
+
+def test_non_negative_float_reads_a_number_and_zero():
+    assert non_negative_float('0') == 0.0
+    assert non_negative_float('2.5') == 2.5
+
+
 def test_perturbed_starts_refuses_an_infinite_frame_rate_in_one_line():
     script = REPO / 'benchmarks' / 'perturbed_starts.py'
     proc = run_python(str(script), '--frame-rate', 'inf', timeout=60)
@@ -346,7 +357,7 @@ def test_group_means_and_published_ranking(tmp_path, monkeypatch, capsys):
     root_b, _ = _synthetic_root(tmp_path / 'b')
     (root_b / 'Toy').rename(root_b / 'Toy2')
     root_b = root_b.rename(root_b.with_name('other'))
-    _Oracle.gt = gt
+    monkeypatch.setattr(_Oracle, 'gt', gt, raising=False)
     monkeypatch.setitem(evaluation.TRACKERS, 'oracle', _Oracle)
     published = {
         'setA': {
@@ -484,7 +495,7 @@ def test_results_are_the_serial_ones_on_local_processes_and_on_a_cluster(
 
 def test_the_digest_leaves_out_the_wall_clock_fields_only(tmp_path, monkeypatch):
     root, gt = _synthetic_root(tmp_path)
-    _Oracle.gt = gt
+    monkeypatch.setattr(_Oracle, 'gt', gt, raising=False)
     monkeypatch.setitem(evaluation.TRACKERS, 'oracle', _Oracle)
     assert (
         main([str(root), '--trackers', 'oracle', '--out', str(tmp_path / 'out'), '--jobs', '1'])
