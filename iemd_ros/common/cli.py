@@ -109,7 +109,7 @@ def positive_float(text: str) -> float:
         For text that is not a number, or a number not finite and > 0.
 
     """
-    return _finite_float(text, 0.0, strict=True)
+    return _finite_float(text, zero=False)
 
 
 def non_negative_float(text: str) -> float:
@@ -132,17 +132,17 @@ def non_negative_float(text: str) -> float:
         For text that is not a number, or a number not finite and >= 0.
 
     """
-    return _finite_float(text, 0.0, strict=False)
+    return _finite_float(text, zero=True)
 
 
-def _finite_float(text: str, least: float, strict: bool) -> float:
-    """Return ``text`` as a finite number above ``least`` (or equal to it unless ``strict``)."""
+def _finite_float(text: str, zero: bool) -> float:
+    """Return ``text`` as a finite number > 0, or >= 0 with ``zero``."""
     try:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not (math.isfinite(v) and (v > least if strict else v >= least)):
-        bound = f'> {least:g}' if strict else f'>= {least:g}'
+    if not (math.isfinite(v) and (v >= 0 if zero else v > 0)):
+        bound = '>= 0' if zero else '> 0'
         raise argparse.ArgumentTypeError(f'must be a finite number {bound}, got {text!r}')
     return v
 

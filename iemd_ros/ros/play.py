@@ -118,7 +118,8 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
     remap : dict, optional
         Bag topic -> published topic.
     delay_s, wait_subscribers_s : float
-        Sleep before playing; wait up to this long until every topic has a subscriber.
+        Sleep before playing; wait up to this long until every topic has a subscriber (s, finite,
+        >= 0).
     clock : bool
         Also publish ``/clock`` with the log times.
     qos_depth : int
