@@ -251,6 +251,13 @@ def test_cmu_desk_excerpt(imu_root, tmp_path):
     gt, flags = parse_groundtruth(tmp_path / 'gt.txt', with_flags=True)
     np.testing.assert_allclose(gt, rec.gt_boxes[10:15], atol=1e-9)
     assert list(flags) == list(rec.gt_flags[10:15])
+    # a margin that is not a finite number of seconds is refused before the bag is written
+    for margin in (-1.0, float('inf'), float('nan')):
+        with pytest.raises(ValueError, match='--imu-margin must be a finite number >= 0'):
+            write_bag(
+                src, tmp_path / f'bad{margin}', 'mcap', first=10, count=5, imu_margin_s=margin
+            )
+        assert not (tmp_path / f'bad{margin}').exists()
 
 
 def test_phone_excerpt(imu_root, tmp_path):
@@ -303,6 +310,10 @@ def test_bad_input(seq, tmp_path, capsys):
         ([str(tmp_path / 'empty'), str(tmp_path / 'o2')], 'holds no image'),
         ([str(tmp_path / 'empty'), str(tmp_path / 'exists')], 'holds no image'),
         ([str(tmp_path / 'empty'), str(tmp_path / 'o3'), '--format', 'zip'], 'invalid choice'),
+        (
+            [str(tmp_path / 'empty'), str(tmp_path / 'o3'), '--imu-margin', 'inf'],
+            'must be a finite number >= 0',
+        ),
     ]
     for argv, text in cases:
         assert text in cli_error(main, argv, capsys, 'iemd-make-bag: error:')

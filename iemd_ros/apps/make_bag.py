@@ -53,7 +53,7 @@ from iemd_ros.bags.make import (
     source_from_folder,
     write_bag,
 )
-from iemd_ros.common.cli import cli_main, CliParser
+from iemd_ros.common.cli import cli_main, CliParser, non_negative_float
 from iemd_ros.common.progress import Progress
 from iemd_ros.messages.conversions import COMPRESSED_CODECS, JPEG_QUALITY
 
@@ -96,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         '--imu-margin',
-        type=float,
+        type=non_negative_float,
         default=0.5,
         metavar='S',
         help='keep IMU samples this many seconds around the frames (default 0.5)',

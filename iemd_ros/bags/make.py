@@ -82,6 +82,7 @@ from __future__ import annotations
 from collections.abc import Callable
 import csv
 from dataclasses import dataclass
+import math
 from pathlib import Path
 
 import cv2
@@ -527,7 +528,7 @@ def write_bag(
     count : int, optional
         Number of frames (default: to the last).
     imu_margin_s : float, optional
-        IMU samples this close to the first/last frame are kept, s.
+        IMU samples this close to the first/last frame are kept, s (finite, >= 0).
     topics : dict, optional
         ``image``, ``camera_info``, ``imu`` topic names replacing :data:`DEFAULT_TOPICS`.
     frame_id : str, optional
@@ -565,8 +566,8 @@ def write_bag(
     if compress is not None:
         check_compression(compress, quality)  # before the bag is opened
     last = _last_frame(source, first, count)
-    if imu_margin_s < 0:
-        raise ValueError(f'--imu-margin must be >= 0 s, got {imu_margin_s}')
+    if not (math.isfinite(imu_margin_s) and imu_margin_s >= 0):
+        raise ValueError(f'--imu-margin must be a finite number >= 0 (s), got {imu_margin_s}')
     if gt_out is not None and source.gt_boxes is None:
         raise ValueError(f'{source.name} has no ground truth to write to {gt_out}')
     tp = _topics(topics, compress)
