@@ -365,6 +365,19 @@ def test_bad_input(seq, tmp_path, capsys):
     ]:
         assert text in cli_error(main, argv, capsys)
     assert not any((tmp_path / f'o{k}').exists() for k in range(4, 13))  # no partial output
+    for argv, text in [
+        ([str(folder), str(tmp_path / 'o13'), '--fps', 'inf'], 'must be a finite number > 0'),
+        (
+            [str(folder), str(tmp_path / 'o14'), '--time-offset-ms', 'nan'],
+            'must be a finite number',
+        ),
+    ]:
+        assert text in cli_error(main, argv, capsys, 'iemd-make-bag: error:')
+    # the library refuses what the command line refuses
+    with pytest.raises(ValueError, match='--fps must be a finite number > 0'):
+        source_from_folder(folder, fps=float('inf'))
+    with pytest.raises(ValueError, match='--time-offset-ms must be a finite number'):
+        source_from_folder(folder, time_offset_ms=float('inf'))
 
 
 def test_cli_compress_and_quality(seq, tmp_path, capsys):

@@ -47,7 +47,7 @@ from helpers import (
 )
 from iemd_ros import TrackerConfig
 from iemd_ros.apps.eval import main
-from iemd_ros.common.cli import non_negative_float, positive_float
+from iemd_ros.common.cli import finite_float, non_negative_float, positive_float
 from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation import ope as evaluation
 from iemd_ros.evaluation.ope import (
@@ -311,6 +311,18 @@ def test_non_negative_float_refuses_what_is_not_a_finite_number_from_zero(text):
 def test_non_negative_float_reads_a_number_and_zero():
     assert non_negative_float('0') == 0.0
     assert non_negative_float('2.5') == 2.5
+
+
+@pytest.mark.parametrize('text', ['inf', '-inf', 'nan', 'later', ''])
+def test_finite_float_refuses_what_is_not_a_finite_number(text):
+    with pytest.raises(argparse.ArgumentTypeError):
+        finite_float(text)
+
+
+def test_finite_float_reads_any_finite_number():
+    assert finite_float('-4.5') == -4.5
+    assert finite_float('0') == 0.0
+    assert finite_float('1e3') == 1000.0
 
 
 def test_perturbed_starts_refuses_an_infinite_frame_rate_in_one_line():

@@ -573,6 +573,10 @@ def test_bad_input(seq, bags, tmp_path, capsys):
         ([str(bags / 'shaky'), '--init', '10,10,0,20'], 'positive size'),
         ([str(bags / 'shaky'), '--init', '10,10,20'], '--init must be 4 numbers'),
         (
+            [str(bags / 'shaky'), '--init', init, '--time-offset-ms', 'inf'],
+            "must be a finite number, got 'inf'",
+        ),
+        (
             [str(bags / 'shaky'), '--init', init, '--gt', str(tmp_path / 'none.txt')],
             'cannot read ground truth',
         ),

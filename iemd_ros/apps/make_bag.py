@@ -53,7 +53,13 @@ from iemd_ros.bags.make import (
     source_from_folder,
     write_bag,
 )
-from iemd_ros.common.cli import cli_main, CliParser, non_negative_float
+from iemd_ros.common.cli import (
+    cli_main,
+    CliParser,
+    finite_float,
+    non_negative_float,
+    positive_float,
+)
 from iemd_ros.common.progress import Progress
 from iemd_ros.messages.conversions import COMPRESSED_CODECS, JPEG_QUALITY
 
@@ -103,7 +109,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         '--fps',
-        type=float,
+        type=positive_float,
         default=None,
         help='frame rate for sources without stamps (default 30)',
     )
@@ -124,7 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         '--time-offset-ms',
-        type=float,
+        type=finite_float,
         default=None,
         help='image folder: t_imu = t_cam + offset (Kalibr); the IMU stamps are shifted by '
         '-offset',

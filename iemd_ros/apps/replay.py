@@ -67,7 +67,7 @@ from iemd_ros.bags.batch import (
     RESULT_BAG_SUFFIX,
 )
 from iemd_ros.bags.replay import CSV_HEADER, parse_box, replay, ReplayResult
-from iemd_ros.common.cli import cli_main, CliParser, split_ros_args
+from iemd_ros.common.cli import cli_main, CliParser, finite_float, split_ros_args
 from iemd_ros.common.parallel import add_worker_arguments, Workers
 from iemd_ros.datasets.otb import parse_groundtruth
 from iemd_ros.evaluation.metrics import score_sequence, SequenceScores
@@ -168,7 +168,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         '--time-offset-ms',
-        type=float,
+        type=finite_float,
         default=None,
         help='gyro time offset t_d (t_imu = t_cam + t_d); default from --config, else 0',
     )

@@ -193,8 +193,8 @@ class BagSource:
 
 
 def _frame_rate_stamps(n: int, fps: float) -> np.ndarray:
-    if not fps > 0:
-        raise ValueError(f'--fps must be > 0, got {fps}')
+    if not (math.isfinite(fps) and fps > 0):
+        raise ValueError(f'--fps must be a finite number > 0, got {fps}')
     return _BASE_NS + np.round(np.arange(n) * 1e9 / fps).astype(np.int64)
 
 
@@ -257,7 +257,7 @@ def source_from_folder(
     camera_yaml : str or path-like, optional
         ROS camera_info YAML (for a recording: used instead of its own calibration).
     time_offset_ms : float, optional
-        The offset t_d of ``imu_csv``, ms (``t_imu = t_cam + t_d``).
+        The offset t_d of ``imu_csv``, ms (``t_imu = t_cam + t_d``; finite).
     imu_frame_id : str, optional
         ``frame_id`` of the ``imu_csv`` samples.
 
@@ -276,6 +276,8 @@ def source_from_folder(
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f'source {folder} is not a folder')
+    if time_offset_ms is not None and not math.isfinite(time_offset_ms):
+        raise ValueError(f'--time-offset-ms must be a finite number, got {time_offset_ms}')
     camera = CameraModel.from_yaml(camera_yaml) if camera_yaml else None
     if list(folder.glob('*_img.log')) or (folder / 'derived_gyro_camframe.csv').exists():
         if fps or stamps or imu_csv or time_offset_ms is not None:

@@ -43,6 +43,7 @@ __all__ = [
     'CliParser',
     'UsageError',
     'cli_main',
+    'finite_float',
     'non_negative_float',
     'one_line',
     'positive_float',
@@ -89,6 +90,29 @@ class CliParser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
+def finite_float(text: str) -> float:
+    """
+    Return ``text`` as a finite number: an argparse ``type``.
+
+    Parameters
+    ----------
+    text : str
+        The argument.
+
+    Returns
+    -------
+    float
+        Its value.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        For text that is not a number, or a number not finite.
+
+    """
+    return _finite_float(text)
+
+
 def positive_float(text: str) -> float:
     """
     Return ``text`` as a finite number > 0: an argparse ``type``.
@@ -109,7 +133,7 @@ def positive_float(text: str) -> float:
         For text that is not a number, or a number not finite and > 0.
 
     """
-    return _finite_float(text, zero=False)
+    return _finite_float(text, lambda v: v > 0, ' > 0')
 
 
 def non_negative_float(text: str) -> float:
@@ -132,18 +156,19 @@ def non_negative_float(text: str) -> float:
         For text that is not a number, or a number not finite and >= 0.
 
     """
-    return _finite_float(text, zero=True)
+    return _finite_float(text, lambda v: v >= 0, ' >= 0')
 
 
-def _finite_float(text: str, zero: bool) -> float:
-    """Return ``text`` as a finite number > 0, or >= 0 with ``zero``."""
+def _finite_float(
+    text: str, holds: Callable[[float], bool] | None = None, bound: str = ''
+) -> float:
+    """Return ``text`` as a finite number that ``holds`` accepts (``bound`` says so in words)."""
     try:
         v = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not (math.isfinite(v) and (v >= 0 if zero else v > 0)):
-        bound = '>= 0' if zero else '> 0'
-        raise argparse.ArgumentTypeError(f'must be a finite number {bound}, got {text!r}')
+    if not (math.isfinite(v) and (holds is None or holds(v))):
+        raise argparse.ArgumentTypeError(f'must be a finite number{bound}, got {text!r}')
     return v
 
 
