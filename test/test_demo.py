@@ -32,7 +32,7 @@ iemd-demo: generates the shaky-camera bag, replays it with and without gyro.
 
 Prints the table and writes the plot -- with no data from ../shared.
 """
-from helpers import csv_boxes, PNG_SIGNATURE
+from helpers import cli_error, csv_boxes, PNG_SIGNATURE
 from iemd_ros.apps.demo import main
 from iemd_ros.bags.replay import replay
 from iemd_ros.datasets.otb import parse_groundtruth
@@ -72,3 +72,10 @@ def test_demo_end_to_end(tmp_path, capsys):
     # re-running replaces the outputs (no "exists already")
     assert main(['--out', str(out), '--frames', '3']) == 0
     assert len(csv_boxes(out / 'replay_gyro.csv')) == 3
+
+
+def test_a_bad_peak_rate_is_refused_in_one_line(tmp_path, capsys):
+    for rate in ('nan', 'inf', '-50'):
+        argv = ['--max-rate', rate, '--out', str(tmp_path)]
+        assert 'must be a finite number >= 0' in cli_error(main, argv, capsys, 'iemd-demo: error:')
+    assert not any(tmp_path.iterdir())  # nothing written

@@ -55,7 +55,7 @@ import time
 from iemd_ros.apps.replay import score_replay
 from iemd_ros.bags.make import source_from_synthetic, write_bag
 from iemd_ros.bags.replay import replay
-from iemd_ros.common.cli import cli_main, CliParser
+from iemd_ros.common.cli import cli_main, CliParser, non_negative_float
 from iemd_ros.datasets.synthetic import generate, SyntheticConfig
 from iemd_ros.evaluation.metrics import iou, OTB_THRESHOLDS
 import numpy as np
@@ -214,7 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         '--max-rate',
-        type=float,
+        type=non_negative_float,
         default=200.0,
         help='peak camera rotation rate, deg/s (default 200)',
     )
