@@ -32,7 +32,6 @@ iemd-eval end to end (iemd_ros.evaluation.ope).
 
 Protocol wiring on synthetic data, CLI on real OTB frames.
 """
-import argparse
 import json
 from pathlib import Path
 
@@ -47,7 +46,6 @@ from helpers import (
 )
 from iemd_ros import TrackerConfig
 from iemd_ros.apps.eval import main
-from iemd_ros.common.cli import finite_float, non_negative_float, positive_float
 from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation import ope as evaluation
 from iemd_ros.evaluation.ope import (
@@ -289,40 +287,6 @@ def test_cli_iemd_parameters_from_the_node_parameter_file(otb_root, tmp_path):
 )
 def test_bad_arguments_exit_2_one_line(argv, match, capsys):
     assert match in cli_error(main, argv, capsys, 'iemd-eval: error:')
-
-
-@pytest.mark.parametrize('text', ['inf', '-inf', 'nan', '0', '-2', 'fast', ''])
-def test_positive_float_refuses_what_is_not_a_finite_number_above_zero(text):
-    with pytest.raises(argparse.ArgumentTypeError):
-        positive_float(text)
-
-
-def test_positive_float_reads_a_number():
-    assert positive_float('12.5') == 12.5
-    assert positive_float('1e-3') == 0.001
-
-
-@pytest.mark.parametrize('text', ['inf', '-inf', 'nan', '-1e-9', '-2', 'soon', ''])
-def test_non_negative_float_refuses_what_is_not_a_finite_number_from_zero(text):
-    with pytest.raises(argparse.ArgumentTypeError):
-        non_negative_float(text)
-
-
-def test_non_negative_float_reads_a_number_and_zero():
-    assert non_negative_float('0') == 0.0
-    assert non_negative_float('2.5') == 2.5
-
-
-@pytest.mark.parametrize('text', ['inf', '-inf', 'nan', 'later', ''])
-def test_finite_float_refuses_what_is_not_a_finite_number(text):
-    with pytest.raises(argparse.ArgumentTypeError):
-        finite_float(text)
-
-
-def test_finite_float_reads_any_finite_number():
-    assert finite_float('-4.5') == -4.5
-    assert finite_float('0') == 0.0
-    assert finite_float('1e3') == 1000.0
 
 
 def test_perturbed_starts_refuses_an_infinite_frame_rate_in_one_line():
