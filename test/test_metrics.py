@@ -156,6 +156,11 @@ def test_score_sequence_excludes_absent_gt_frames():
     assert s.overlap_gt_04 == pytest.approx(1 / 3)
     assert s.success_auc == pytest.approx(np.mean(s.success_curve))
     assert s.fps == 12.5 and s.to_dict()['name'] == 'toy'
+    assert s.recall == s.average_overlap  # every frame reported
+    # a frame reported lost scores 0 in the recall, whatever its box; an absent one is not scored
+    lost = score_sequence(pred, gt, 'toy', reported=[True, False, False, True])
+    assert lost.recall == pytest.approx((1 + 0 + 0) / 3)
+    assert lost.average_overlap == s.average_overlap
 
 
 def test_score_sequence_errors():
@@ -163,6 +168,8 @@ def test_score_sequence_errors():
         score_sequence(np.zeros((2, 4)), np.ones((3, 4)), 'x')
     with pytest.raises(ValueError, match='no frame has a valid'):
         score_sequence(np.zeros((2, 4)), np.full((2, 4), np.nan), 'x')
+    with pytest.raises(ValueError, match='3 report flags for 2'):
+        score_sequence(np.zeros((2, 4)), np.ones((2, 4)), 'x', reported=[True] * 3)
 
 
 def test_a_gain_on_every_run_has_a_tight_interval_and_one_sequence_alone_does_not():

@@ -134,10 +134,12 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     # the gyro prior keeps the target under this shake (IoU > 0.3 on every frame)
     assert iou(boxes, seq.gt_boxes).min() > 0.3
     # --gt prints the evaluation table with the scores of the CSV's boxes
-    s = score_sequence(boxes, seq.gt_boxes)
+    s = score_sequence(boxes, seq.gt_boxes, reported=[r[6] != 'lost' for r in rows[1:]])
     assert (
         'AO%' in printed and f'{100 * s.average_overlap:6.1f}' in printed and 'iemd+g' in printed
     )
+    # and the recall, the lost frames scored 0
+    assert 'R%' in printed and f'{100 * s.recall:6.1f}' in printed
     # output bag: Detection2DArray + DiagnosticArray per image, stamped and logged like the images
     out = read_all(tmp_path / 'out')
     inp = read_all(bags / 'shaky')

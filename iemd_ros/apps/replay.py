@@ -91,7 +91,8 @@ def score_replay(result: ReplayResult, gt: np.ndarray, name: str) -> SequenceSco
             f'the ground truth has {len(gt)} boxes for {len(boxes)} images in the bag'
         )
     fps = len(boxes) / result.track_s if result.track_s > 0 else math.inf
-    return score_sequence(boxes, gt, name, fps=fps)
+    reported = [r.tracking for r in result.results]
+    return score_sequence(boxes, gt, name, fps=fps, reported=reported)
 
 
 def evaluation_table(

@@ -321,6 +321,10 @@ class SequenceScores:
         OTB precision at 20 px.
     overlap_gt_0, overlap_gt_04 : float
         Fractions of frames with overlap > 0 and > 0.4.
+    recall : float
+        The average overlap with the frames the tracker did not report the target on scored 0
+        (VOT's long-term tracking recall): what its reports (published detections) are worth.
+        Equal to ``average_overlap`` for a tracker that reports every frame.
     fps : float or None, optional
         The run's speed.
     success_curve : list of float, optional
@@ -336,6 +340,7 @@ class SequenceScores:
     precision_20: float
     overlap_gt_0: float
     overlap_gt_04: float
+    recall: float
     fps: float | None = None
     success_curve: list[float] = field(default_factory=list)
 
@@ -353,7 +358,7 @@ class SequenceScores:
 
 
 def score_sequence(
-    pred_boxes, gt_boxes, name: str = '', fps: float | None = None
+    pred_boxes, gt_boxes, name: str = '', fps: float | None = None, reported=None
 ) -> SequenceScores:
     """
     Score predicted boxes against ground truth over the frames where the GT box is valid.
@@ -366,6 +371,8 @@ def score_sequence(
         The sequence's name.
     fps : float, optional
         The run's speed, recorded as it is.
+    reported : array_like of bool, optional
+        (N,) whether the tracker reported the target on each frame (not lost); None: every frame.
 
     Returns
     -------
@@ -375,7 +382,8 @@ def score_sequence(
     Raises
     ------
     ValueError
-        For boxes of other shapes or of different numbers, or no valid GT box.
+        For boxes of other shapes or of different numbers, report flags of another number, or
+        no valid GT box.
 
     """
     pred = _as_boxes(pred_boxes, 'pred_boxes')
@@ -383,6 +391,11 @@ def score_sequence(
     if len(pred) != len(gt):
         raise ValueError(
             f'{name or "sequence"}: {len(pred)} predicted boxes for {len(gt)} ground-truth boxes'
+        )
+    rep = np.ones(len(gt), bool) if reported is None else np.asarray(reported, bool).ravel()
+    if len(rep) != len(gt):
+        raise ValueError(
+            f'{name or "sequence"}: {len(rep)} report flags for {len(gt)} ground-truth boxes'
         )
     present = valid_boxes(gt)
     if not present.any():
@@ -399,6 +412,7 @@ def score_sequence(
         precision_20=precision_at(ce, PRECISION_THRESHOLD),
         overlap_gt_0=fraction_above(ov, 0.0),
         overlap_gt_04=fraction_above(ov, 0.4),
+        recall=average_overlap(np.where(rep[present], ov, 0.0)),
         fps=fps,
         success_curve=[float(c) for c in curve],
     )

@@ -36,8 +36,9 @@ Protocol (Wu, Lim & Yang 2013; paper, Section "Experiments"): each tracker is in
 GT box of the first frame and then updated on every later frame without re-initialisation.  The
 first frame counts as tracked with the GT box.  Scores are those of
 :mod:`iemd_ros.evaluation.metrics` (average overlap = the paper's table metric, OTB success AUC,
-precision@20px, overlap > 0 / > 0.4).  The mean over sequences is the plain mean of the
-per-sequence figures (OTB averages the per-sequence success curves), fps included.
+precision@20px, overlap > 0 / > 0.4, and the recall ``R``: the average overlap with the frames a
+tracker reported failed, iEMD's lost frames, scored 0).  The mean over sequences is the plain mean
+of the per-sequence figures (OTB averages the per-sequence success curves), fps included.
 
 Speed: only the ``init``/``update`` calls are timed (image decoding is not); fps = frames / (init
 time + sum of update times).  A job is one tracker on one sequence, run in one process; the jobs
@@ -396,7 +397,7 @@ def evaluate_sequence(seq: Sequence, tracker: TrackerAdapter) -> tuple[SequenceS
     """
     interval = None if seq.frame_rate is None else 1.0 / seq.frame_rate
     run = run_tracker(tracker, seq.frames(), seq.gt_boxes[0], interval)
-    return score_sequence(run.boxes, seq.gt_boxes, seq.name, fps=run.fps), run
+    return score_sequence(run.boxes, seq.gt_boxes, seq.name, fps=run.fps, reported=run.ok), run
 
 
 @dataclass(frozen=True)
@@ -480,6 +481,7 @@ def mean_scores(scores: list[SequenceScores]) -> dict:
         'precision_20',
         'overlap_gt_0',
         'overlap_gt_04',
+        'recall',
         'fps',
     )
     out = {k: float(np.mean([getattr(s, k) for s in scores])) for k in keys}
@@ -603,14 +605,14 @@ def format_table(results: dict, trackers: list[str], names: list[str]) -> str:
 
     """
     header = (f'{"sequence":<14} {"tracker":<7} {"frames":>6} {"AO%":>6} {"AUC%":>6} {"P@20%":>6} '
-              f'{">0%":>6} {">40%":>6} {"fps":>8}')
+              f'{">0%":>6} {">40%":>6} {"R%":>6} {"fps":>8}')
     lines = [header, '-' * len(header)]
 
     def row(label: str, trk: str, s: dict, n: int) -> str:
         return (
             f'{label:<14} {trk:<7} {n:>6d} {_pct(s["average_overlap"])} {_pct(s["success_auc"])} '
             f'{_pct(s["precision_20"])} {_pct(s["overlap_gt_0"])} {_pct(s["overlap_gt_04"])} '
-            f'{s["fps"]:8.1f}'
+            f'{_pct(s["recall"])} {s["fps"]:8.1f}'
         )
 
     for name in names:
