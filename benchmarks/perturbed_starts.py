@@ -63,7 +63,9 @@ reference saved from an older tracker is seen as such.
 footage of lower resolution than the shared sequences, and smaller targets
 (docs/decisions.md#resolution-probe).  ``--mono`` runs every tracker on one-channel grey frames
 (OpenCV's BGR-to-grey weights), as a monochrome camera's ``mono8`` images
-(docs/decisions.md#mono-camera).
+(docs/decisions.md#mono-camera).  ``--figure recall`` scores every run by its recall instead of
+its average overlap: the frames a tracker reported lost score 0, as its published detections do
+(docs/decisions.md#published-recall).
 """
 from __future__ import annotations
 
@@ -103,8 +105,16 @@ TEMPORAL = tuple((0.0, 0.0, 1.0, k / SEGMENTS) for k in range(SEGMENTS))
 START_SETS = {'diagonal': DIAGONALS, 'sre': DIAGONALS + AXES + SCALES, 'tre': TEMPORAL}
 # the options a saved run records, and the value a file saved before an option existed ran with
 SETTINGS = {
-    'starts': None, 'shift': None, 'resolution': 1.0, 'mono': False, 'every': 1, 'frame_rate': None
+    'starts': None,
+    'shift': None,
+    'resolution': 1.0,
+    'mono': False,
+    'every': 1,
+    'frame_rate': None,
+    'figure': 'ao',
 }
+# what a run can be scored by (--figure), in the order run() gives them, and its short name
+FIGURES = {'ao': 'AO', 'recall': 'R'}
 
 
 def start_box(first: np.ndarray, dx: float, dy: float, scale: float, shift: float) -> np.ndarray:
@@ -133,7 +143,7 @@ def start_frame(truth: np.ndarray, at: float) -> int:
 
 def run(job):
     """
-    [(average overlap, median update ms) per start] of each run on one sequence.
+    [(average overlap, recall, median update ms) per start] of each run on one sequence.
 
     Decoded once.
     """
@@ -150,8 +160,14 @@ def run(job):
         for k, start in begins:
             tracker = make_tracker(tracker_name, config)
             result = run_tracker(tracker, frames[k:], start, interval)
-            scores = score_sequence(result.boxes, truth[k:], name)
-            rows.append((scores.average_overlap, float(np.median(result.update_seconds) * 1e3)))
+            scores = score_sequence(result.boxes, truth[k:], name, reported=result.ok)
+            rows.append(
+                (
+                    scores.average_overlap,
+                    scores.recall,
+                    float(np.median(result.update_seconds) * 1e3),
+                )
+            )
         out.append(rows)
     return out
 
@@ -233,9 +249,16 @@ def main() -> None:
         'N frames at --frame-rate or, unknown, at the default reference_rate '
         '(default: 1)',
     )
+    parser.add_argument(
+        '--figure',
+        choices=sorted(FIGURES),
+        default='ao',
+        help='what a run scores: ao, its average overlap; recall, the same with the frames the '
+        'tracker reported lost scored 0 (default: ao)',
+    )
     parser.add_argument('--jobs', type=int, default=2)
     parser.add_argument(
-        '--save', type=Path, help='write the average overlap of every run to this JSON file'
+        '--save', type=Path, help='write the figure of every run to this JSON file'
     )
     parser.add_argument(
         '--against', type=Path, help='compare with the first tracker of a run saved by --save'
@@ -296,20 +319,21 @@ def main() -> None:
     )
     overlaps = {}
     first = runs[0][0]
+    figure, name = list(FIGURES).index(args.figure), FIGURES[args.figure]
     for i, (label, _, _) in enumerate(runs):
         rows = [row for per_sequence in results for row in per_sequence[i]]
-        overlap = np.array([ao for ao, _ in rows]).reshape(len(names), n_starts) * 100
+        overlap = np.array([row[figure] for row in rows]).reshape(len(names), n_starts) * 100
         overlaps[label] = overlap
-        speed = np.median([ms for _, ms in rows])
+        speed = np.median([row[-1] for row in rows])
         starts = ' '.join(f'{v:4.1f}' for v in overlap.mean(axis=0))
         print(
-            f'{label:60s} mean AO {overlap.mean():5.1f} %  per start {starts}  median update '
+            f'{label:60s} mean {name} {overlap.mean():5.1f} %  per start {starts}  median update '
             f'{speed:.1f} ms'
         )
         for group in sorted(set(groups.values())):
             rows_of = [k for k, n in enumerate(names) if groups[n] == group]
             print(
-                f'    {group}: mean AO {overlap[rows_of].mean():5.1f} % over {len(rows_of)} '
+                f'    {group}: mean {name} {overlap[rows_of].mean():5.1f} % over {len(rows_of)} '
                 f'sequences x {n_starts}'
             )
         print('    ' + ' '.join(f'{n}={v:.1f}' for n, v in zip(names, overlap.mean(axis=1))))
