@@ -640,15 +640,15 @@ def test_a_lost_frames_re_detection_searches_on_a_worker_as_the_serial_schedule(
     uav_root, monkeypatch
 ):
     """
-    boat5 frames 1-65, lost from frame 50: re-detection gives the results of ``threads=False``.
+    MountainBike6 frames 1-45, lost from frame 25: re-detection as with ``threads=False``.
 
     With threads the caller samples only each frame's own search region; every re-detection region
     (where the target was lost, at the whole-frame strip's peak, centred again, at another size)
     is sampled and searched on a worker thread, and the strip on the lost frames after the first
     FRAME_SEARCH_AFTER.
     """
-    seq = load_sequence(uav_root / 'boat5')
-    frames = [read_frame(p) for p in seq.frame_paths[:65]]
+    seq = load_sequence(uav_root / 'MountainBike6')
+    frames = [read_frame(p) for p in seq.frame_paths[:45]]
     threads = {'sample': [], 'locate': [], 'frame_strip': []}
     for name, calls in threads.items():
         method = getattr(TranslationFilter, name)

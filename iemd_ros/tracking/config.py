@@ -260,7 +260,8 @@ class TrackerConfig:
     )
     lost_factor: float = param(
         1.0,
-        'lost when EMD > this x the background EMD measured at init',
+        'held when EMD > this x the background EMD measured at init (lost where the '
+        "filter's peak cannot tell)",
         range=(0.01, 100.0),
         decision='background-emd',
     )

@@ -134,7 +134,8 @@ class TrackResult:
     predicted_box: tuple[float, float, float, float] | None = None
     # why the window counts as lost, or why the models did not learn (held), with the figures
     reason: str = ''
-    # tracked, but the models did not learn and the size was kept (occlusion check)
+    # tracked, but the models did not learn and the size was kept (the occlusion check, or the
+    # EMD above the background's while the filter's peak does not say lost)
     held: bool = False
     cause: Cause | None = None  # the reason's kind (None: tracked and learned)
 
@@ -403,6 +404,13 @@ class IemdTracker:
             )
         codings = sum(s.codings for s in searches) + final.codings
         cause, reason = self._lost_reason(emd, new_center, new_size, angle, frame.shape)
+        # while tracking, a window the EMD no longer takes for the target is held, not lost, as
+        # long as the filter's peak does not say lost: the box is still reported
+        # (docs/decisions.md#emd-held)
+        emd_held = cause is Cause.EMD_ABOVE_BACKGROUND and tracked and self._filter_holds()
+        if emd_held:
+            emd_reason, cause = reason, None
+            new_center, new_size = final.center, best.model.size
         if cause is None:  # lost until the peak is back to found_response x its mean: hysteresis
             cause, reason = self._peak_check(
                 cfg.found_response if self._lost else cfg.lost_response
@@ -431,9 +439,11 @@ class IemdTracker:
         if search is not None:  # found by the local search: the caller may reuse the frame next
             search.result()
         self._lost, self._lost_frames, self._anchor = False, 0, None
-        held = bool(best.held_reason)
+        held = bool(best.held_reason) or emd_held
         self._center, self._size, self._angle = new_center, new_size, angle
-        if held:
+        if emd_held:
+            cause, reason = Cause.EMD_ABOVE_BACKGROUND, emd_reason
+        elif held:
             cause, reason = Cause.LOW_RESPONSE, best.held_reason
         else:
             if self._peak_apce is not None:
@@ -526,6 +536,18 @@ class IemdTracker:
         return (
             Cause.NO_PEAK,
             f'filter peak {peak:.3f} < {threshold} x its running mean {self._confidence:.3f}',
+        )
+
+    def _filter_holds(self) -> bool:
+        """
+        Whether the translation filter's peak near the prediction does not say lost.
+
+        Not below ``lost_response`` times its running mean (before any frame learned it cannot say
+        so); False without the filter.
+        """
+        return (
+            self._translation_filter is not None
+            and self._peak_check(self.config.lost_response)[0] is None
         )
 
     def _redetect(
