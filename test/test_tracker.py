@@ -767,3 +767,29 @@ def test_re_detection_tries_each_other_size_in_turn_within_the_scale_bounds():
     large = [_redetect_factor(k, (90, 90), shape) for k in range(4)]
     assert max(large) == pytest.approx(100 / 90) and min(large) == REDETECT_SIZES[0]
     assert {_redetect_factor(k, (MIN_SIDE_PX, 50), shape) for k in range(2)} == {1.0}
+
+
+def test_a_window_the_emd_rejects_is_held_while_the_filter_finds_it_and_lost_without_it():
+    """
+    While tracking, the EMD above the background's holds a frame the filter's peak keeps.
+
+    The box is reported and nothing learns (the response's running mean stays); without the
+    translation filter (``translation_weight`` 0) the same frame is lost.
+    """
+    frame, box = texture(), (100, 80, 40, 40)
+    outcomes = {}
+    for weight in (TrackerConfig().translation_weight, 0.0):
+        tracker = IemdTracker(TrackerConfig(translation_weight=weight), threads=False)
+        tracker.init(frame, box)
+        first = tracker.update(frame)  # learned: the filter's running mean exists
+        tracker._background_emd = 1e-12  # every window's EMD is above it from here on
+        mean = tracker._confidence
+        results = [tracker.update(frame) for _ in range(3)]
+        outcomes[weight] = results
+        assert not first.lost and not first.held
+        assert all(r.cause is Cause.EMD_ABOVE_BACKGROUND for r in results)
+        assert tracker._confidence == mean  # nothing learned
+    held, lost = outcomes[TrackerConfig().translation_weight], outcomes[0.0]
+    assert all(r.held and not r.lost for r in held)
+    assert all(iou(np.array(r.box), np.array(box, float))[0] > 0.9 for r in held)
+    assert all(r.lost and not r.held for r in lost)
