@@ -319,7 +319,7 @@ def main() -> None:
     )
     overlaps = {}
     first = runs[0][0]
-    figure, name = list(FIGURES).index(args.figure), FIGURES[args.figure]
+    figure, short = list(FIGURES).index(args.figure), FIGURES[args.figure]
     for i, (label, _, _) in enumerate(runs):
         rows = [row for per_sequence in results for row in per_sequence[i]]
         overlap = np.array([row[figure] for row in rows]).reshape(len(names), n_starts) * 100
@@ -327,13 +327,13 @@ def main() -> None:
         speed = np.median([row[-1] for row in rows])
         starts = ' '.join(f'{v:4.1f}' for v in overlap.mean(axis=0))
         print(
-            f'{label:60s} mean {name} {overlap.mean():5.1f} %  per start {starts}  median update '
+            f'{label:60s} mean {short} {overlap.mean():5.1f} %  per start {starts}  median update '
             f'{speed:.1f} ms'
         )
         for group in sorted(set(groups.values())):
             rows_of = [k for k, n in enumerate(names) if groups[n] == group]
             print(
-                f'    {group}: mean {name} {overlap[rows_of].mean():5.1f} % over {len(rows_of)} '
+                f'    {group}: mean {short} {overlap[rows_of].mean():5.1f} % over {len(rows_of)} '
                 f'sequences x {n_starts}'
             )
         print('    ' + ' '.join(f'{n}={v:.1f}' for n, v in zip(names, overlap.mean(axis=1))))
