@@ -113,7 +113,7 @@ SETTINGS = {
     'frame_rate': None,
     'figure': 'ao',
 }
-# what a run can be scored by (--figure), in the order run() gives them, and its short name
+# the figures --figure chooses from, in the order run() returns them, with their short names
 FIGURES = {'ao': 'AO', 'recall': 'R'}
 
 

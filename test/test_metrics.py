@@ -157,7 +157,7 @@ def test_score_sequence_excludes_absent_gt_frames():
     assert s.success_auc == pytest.approx(np.mean(s.success_curve))
     assert s.fps == 12.5 and s.to_dict()['name'] == 'toy'
     assert s.recall == s.average_overlap  # every frame reported
-    # a frame reported lost scores 0 in the recall, whatever its box; an absent one is not scored
+    # the recall counts a frame reported lost as a miss whatever its box, and skips an absent one
     lost = score_sequence(pred, gt, 'toy', reported=[True, False, False, True])
     assert lost.recall == pytest.approx((1 + 0 + 0) / 3)
     assert lost.average_overlap == s.average_overlap

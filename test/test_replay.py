@@ -138,7 +138,7 @@ def test_deterministic_csv_and_outputs(seq, bags, tmp_path, capsys):
     assert (
         'AO%' in printed and f'{100 * s.average_overlap:6.1f}' in printed and 'iemd+g' in printed
     )
-    # and the recall, the lost frames scored 0
+    # and the recall, which counts the lost frames as misses
     assert 'R%' in printed and f'{100 * s.recall:6.1f}' in printed
     # output bag: Detection2DArray + DiagnosticArray per image, stamped and logged like the images
     out = read_all(tmp_path / 'out')

@@ -82,7 +82,6 @@ from __future__ import annotations
 from collections.abc import Callable
 import csv
 from dataclasses import dataclass
-import math
 from pathlib import Path
 
 import cv2
@@ -96,6 +95,7 @@ from iemd_ros.bags.io import (
     IMU_TYPE,
     META_PREFIX,
 )
+from iemd_ros.common.cli import finite_float, non_negative_float, positive_float
 from iemd_ros.datasets.otb import (
     IMAGE_SUFFIXES,
     is_sequence_folder,
@@ -193,8 +193,7 @@ class BagSource:
 
 
 def _frame_rate_stamps(n: int, fps: float) -> np.ndarray:
-    if not (math.isfinite(fps) and fps > 0):
-        raise ValueError(f'--fps must be a finite number > 0, got {fps}')
+    positive_float.check('--fps', fps)
     return _BASE_NS + np.round(np.arange(n) * 1e9 / fps).astype(np.int64)
 
 
@@ -276,8 +275,8 @@ def source_from_folder(
     folder = Path(folder)
     if not folder.is_dir():
         raise ValueError(f'source {folder} is not a folder')
-    if time_offset_ms is not None and not math.isfinite(time_offset_ms):
-        raise ValueError(f'--time-offset-ms must be a finite number, got {time_offset_ms}')
+    if time_offset_ms is not None:
+        finite_float.check('--time-offset-ms', time_offset_ms)
     camera = CameraModel.from_yaml(camera_yaml) if camera_yaml else None
     if list(folder.glob('*_img.log')) or (folder / 'derived_gyro_camframe.csv').exists():
         if fps or stamps or imu_csv or time_offset_ms is not None:
@@ -568,8 +567,7 @@ def write_bag(
     if compress is not None:
         check_compression(compress, quality)  # before the bag is opened
     last = _last_frame(source, first, count)
-    if not (math.isfinite(imu_margin_s) and imu_margin_s >= 0):
-        raise ValueError(f'--imu-margin must be a finite number >= 0 (s), got {imu_margin_s}')
+    non_negative_float.check('--imu-margin', imu_margin_s)
     if gt_out is not None and source.gt_boxes is None:
         raise ValueError(f'{source.name} has no ground truth to write to {gt_out}')
     tp = _topics(topics, compress)

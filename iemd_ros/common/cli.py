@@ -41,6 +41,7 @@ import sys
 
 __all__ = [
     'CliParser',
+    'FiniteFloat',
     'UsageError',
     'cli_main',
     'finite_float',
@@ -90,86 +91,98 @@ class CliParser(argparse.ArgumentParser):
         raise UsageError(message)
 
 
-def finite_float(text: str) -> float:
+class FiniteFloat:
     """
-    Return ``text`` as a finite number: an argparse ``type``.
+    A finite number, within a bound when it has one.
+
+    Called with an argument's text it is an argparse ``type``; :meth:`check` refuses the same
+    values passed to a library function, so that a command and its library refuse alike.
 
     Parameters
     ----------
-    text : str
-        The argument.
+    bound : str, optional
+        The bound in words, as the error says it (``' > 0'``); '' for none.
+    holds : callable, optional
+        Whether a finite value is within the bound; None for any.
 
-    Returns
-    -------
-    float
-        Its value.
-
-    Raises
-    ------
-    argparse.ArgumentTypeError
-        For text that is not a number, or a number not finite.
-
-    """
-    return _finite_float(text)
-
-
-def positive_float(text: str) -> float:
-    """
-    Return ``text`` as a finite number > 0: an argparse ``type``.
-
-    Parameters
-    ----------
-    text : str
-        The argument.
-
-    Returns
-    -------
-    float
-        Its value.
-
-    Raises
-    ------
-    argparse.ArgumentTypeError
-        For text that is not a number, or a number not finite and > 0.
+    Examples
+    --------
+    >>> positive_float('2.5')
+    2.5
+    >>> positive_float.check('--rate', 0.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: --rate must be a finite number > 0, got 0.0
 
     """
-    return _finite_float(text, lambda v: v > 0, ' > 0')
+
+    def __init__(self, bound: str = '', holds: Callable[[float], bool] | None = None):
+        self.bound, self.holds = bound, holds
+
+    def __call__(self, text: str) -> float:
+        """
+        Return ``text`` as such a number.
+
+        Parameters
+        ----------
+        text : str
+            The argument.
+
+        Returns
+        -------
+        float
+            Its value.
+
+        Raises
+        ------
+        argparse.ArgumentTypeError
+            For text that is not a number, or a number not finite or outside the bound.
+
+        """
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
+        if not self._accepts(v):
+            raise argparse.ArgumentTypeError(f'must be a finite number{self.bound}, got {text!r}')
+        return v
+
+    def check(self, name: str, value: float) -> float:
+        """
+        Return ``value`` if it is such a number.
+
+        Parameters
+        ----------
+        name : str
+            What the value is, as the error names it (the command's option).
+        value : float
+            The value.
+
+        Returns
+        -------
+        float
+            ``value``.
+
+        Raises
+        ------
+        ValueError
+            For a value not finite or outside the bound.
+
+        """
+        if not self._accepts(value):
+            raise ValueError(f'{name} must be a finite number{self.bound}, got {value}')
+        return value
+
+    def _accepts(self, v: float) -> bool:
+        return math.isfinite(v) and (self.holds is None or self.holds(v))
 
 
-def non_negative_float(text: str) -> float:
-    """
-    Return ``text`` as a finite number >= 0: an argparse ``type``.
-
-    Parameters
-    ----------
-    text : str
-        The argument.
-
-    Returns
-    -------
-    float
-        Its value.
-
-    Raises
-    ------
-    argparse.ArgumentTypeError
-        For text that is not a number, or a number not finite and >= 0.
-
-    """
-    return _finite_float(text, lambda v: v >= 0, ' >= 0')
-
-
-def _finite_float(
-    text: str, holds: Callable[[float], bool] | None = None, bound: str = ''
-) -> float:
-    """Return ``text`` as a finite number that ``holds`` accepts (``bound`` says so in words)."""
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f'not a number: {text!r}') from None
-    if not (math.isfinite(v) and (holds is None or holds(v))):
-        raise argparse.ArgumentTypeError(f'must be a finite number{bound}, got {text!r}')
-    return v
+#: Any finite number.
+finite_float = FiniteFloat()
+#: A finite number > 0.
+positive_float = FiniteFloat(' > 0', lambda v: v > 0)
+#: A finite number >= 0.
+non_negative_float = FiniteFloat(' >= 0', lambda v: v >= 0)
 
 
 def one_line(exc: BaseException) -> str:

@@ -50,11 +50,11 @@ with the log time of each message, for nodes with ``use_sim_time``.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-import math
 import sys
 import time
 
 from iemd_ros.bags.io import BagError, iter_messages, open_bag, ros2_typestore
+from iemd_ros.common.cli import non_negative_float, positive_float
 from iemd_ros.common.progress import Progress
 from iemd_ros.messages.conversions import ns_to_stamp
 from iemd_ros.ros.messages import message_class
@@ -145,11 +145,9 @@ def play(bag, rate: float = 1.0, topics=None, remap: dict | None = None, delay_s
     import rclpy
     from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
-    if not (math.isfinite(rate) and rate > 0):
-        raise ValueError(f'--rate must be a finite number > 0, got {rate}')
-    for name, seconds in (('--delay', delay_s), ('--wait-subscribers', wait_subscribers_s)):
-        if not (math.isfinite(seconds) and seconds >= 0):
-            raise ValueError(f'{name} must be a finite number >= 0, got {seconds}')
+    positive_float.check('--rate', rate)
+    non_negative_float.check('--delay', delay_s)
+    non_negative_float.check('--wait-subscribers', wait_subscribers_s)
     if qos_depth < 1:
         raise ValueError(f'--qos-depth must be >= 1, got {qos_depth}')
     remap = dict(remap or {})
