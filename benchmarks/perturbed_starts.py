@@ -63,7 +63,9 @@ reference saved from an older tracker is seen as such.
 footage of lower resolution than the shared sequences, and smaller targets
 (docs/decisions.md#resolution-probe).  ``--mono`` runs every tracker on one-channel grey frames
 (OpenCV's BGR-to-grey weights), as a monochrome camera's ``mono8`` images
-(docs/decisions.md#mono-camera).  ``--figure recall`` scores every run by its recall instead of
+(docs/decisions.md#mono-camera).  ``--jpeg-quality 30`` runs every tracker on the frames encoded
+as JPEG at that quality and decoded again, as a compressed image stream delivers them
+(docs/decisions.md#jpeg-probe).  ``--figure recall`` scores every run by its recall instead of
 its average overlap: the frames a tracker reported lost score 0, as its published detections do
 (docs/decisions.md#published-recall).
 """
@@ -109,6 +111,7 @@ SETTINGS = {
     'shift': None,
     'resolution': 1.0,
     'mono': False,
+    'jpeg_quality': None,
     'every': 1,
     'frame_rate': None,
     'figure': 'ao',
@@ -147,9 +150,9 @@ def run(job):
 
     Decoded once.
     """
-    name, runs, shift, starts, resolution, mono, every, interval = job
+    name, runs, shift, starts, camera, interval = job
     seq = load_sequence(name)
-    frames, truth = _as_camera(seq.frames(), seq.gt_boxes, resolution, mono, every)
+    frames, truth = _as_camera(seq.frames(), seq.gt_boxes, *camera)
     begins = []  # (first frame, box) of each start, the same for every tracker
     for dx, dy, scale, at in starts:
         k = start_frame(truth, at)
@@ -172,12 +175,15 @@ def run(job):
     return out
 
 
-def _as_camera(frames, boxes, factor: float, mono: bool, every: int) -> tuple[list, np.ndarray]:
+def _as_camera(
+    frames, boxes, factor: float, mono: bool, every: int, jpeg_quality: int | None = None
+) -> tuple[list, np.ndarray]:
     """
     Return the decoded frames and 0-based ground-truth boxes as another camera would give them.
 
     That camera has ``factor`` times the frames' resolution, with ``mono`` one grey channel, and
-    takes every ``every``-th frame.
+    takes every ``every``-th frame; with ``jpeg_quality`` its frames come through a compressed
+    image stream, encoded as JPEG at that quality (OpenCV's encoder) and decoded again.
 
     Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
@@ -193,6 +199,9 @@ def _as_camera(frames, boxes, factor: float, mono: bool, every: int) -> tuple[li
             size = (max(1, round(w * factor)), max(1, round(h * factor)))
             frame = cv2.resize(frame, size, interpolation=cv2.INTER_AREA)
             ratio = np.array([size[0] / w, size[1] / h])
+        if jpeg_quality is not None:
+            _, jpeg = cv2.imencode('.jpg', frame, [cv2.IMWRITE_JPEG_QUALITY, jpeg_quality])
+            frame = cv2.imdecode(jpeg, cv2.IMREAD_UNCHANGED)
         out.append(frame)
     return out, boxes * np.tile(ratio, 2)
 
@@ -235,6 +244,14 @@ def main() -> None:
         '--mono', action='store_true', help='frames turned to one-channel grey (a mono camera)'
     )
     parser.add_argument(
+        '--jpeg-quality',
+        type=int,
+        default=None,
+        metavar='Q',
+        help='frames encoded as JPEG at this quality, 1-100, and decoded again, as a compressed '
+        'image stream delivers them (default: as read)',
+    )
+    parser.add_argument(
         '--frame-rate',
         type=positive_float,
         default=None,
@@ -268,6 +285,8 @@ def main() -> None:
         parser.error(f'--resolution must be in (0, 1], got {args.resolution}')
     if args.every < 1:
         parser.error(f'--every must be >= 1, got {args.every}')
+    if args.jpeg_quality is not None and not 1 <= args.jpeg_quality <= 100:
+        parser.error(f'--jpeg-quality must be in 1-100, got {args.jpeg_quality}')
     rate = args.frame_rate or (None if args.every == 1 else TrackerConfig().reference_rate)
     interval = None if rate is None else args.every / rate
     settings = {key: getattr(args, key) for key in SETTINGS}
@@ -295,8 +314,12 @@ def main() -> None:
             run,
             [
                 (
-                    name, runs, args.shift, START_SETS[args.starts], args.resolution, args.mono,
-                    args.every, interval,
+                    name,
+                    runs,
+                    args.shift,
+                    START_SETS[args.starts],
+                    (args.resolution, args.mono, args.every, args.jpeg_quality),
+                    interval,
                 )
                 for name in names
             ],
@@ -314,6 +337,7 @@ def main() -> None:
         f'{len(names)} sequences x {n_starts} starts ({which})'
         + ('' if args.resolution == 1.0 else f', frames at {args.resolution:g} of their size')
         + (', one-channel grey frames' if args.mono else '')
+        + ('' if args.jpeg_quality is None else f', JPEG at quality {args.jpeg_quality}')
         + ('' if args.every == 1 else f', every {args.every}th frame')
         + ('' if interval is None else f', iEMD told the frames are {interval * 1e3:.1f} ms apart')
     )

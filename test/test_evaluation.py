@@ -32,6 +32,7 @@ iemd-eval end to end (iemd_ros.evaluation.ope).
 
 Protocol wiring on synthetic data, CLI on real OTB frames.
 """
+import importlib.util
 import json
 from pathlib import Path
 
@@ -289,12 +290,43 @@ def test_bad_arguments_exit_2_one_line(argv, match, capsys):
     assert match in cli_error(main, argv, capsys, 'iemd-eval: error:')
 
 
-def test_perturbed_starts_refuses_an_infinite_frame_rate_in_one_line():
-    script = REPO / 'benchmarks' / 'perturbed_starts.py'
-    proc = run_python(str(script), '--frame-rate', 'inf', timeout=60)
+PERTURBED_STARTS = REPO / 'benchmarks' / 'perturbed_starts.py'
+
+
+@pytest.mark.parametrize(
+    'argv, match',
+    [
+        (['--frame-rate', 'inf'], "argument --frame-rate: must be a finite number > 0, got 'inf'"),
+        (['--jpeg-quality', '0'], '--jpeg-quality must be in 1-100, got 0'),
+    ],
+)
+def test_perturbed_starts_refuses_a_bad_camera_in_one_line(argv, match):
+    proc = run_python(str(PERTURBED_STARTS), *argv, timeout=60)
     assert proc.returncode == 2
     assert 'Traceback' not in proc.stderr
-    assert "argument --frame-rate: must be a finite number > 0, got 'inf'" in proc.stderr
+    assert match in proc.stderr
+
+
+def test_perturbed_starts_jpeg_camera_compresses_at_its_quality_and_keeps_the_boxes():
+    spec = importlib.util.spec_from_file_location('perturbed_starts', PERTURBED_STARTS)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    rng = np.random.default_rng(0)
+    frames = [rng.integers(0, 256, (48, 64, 3), dtype=np.uint8) for _ in range(3)]
+    boxes = [[1.0, 2.0, 10.0, 12.0]] * 3
+
+    def error(quality, mono=False):
+        out, kept = script._as_camera(iter(frames), boxes, 1.0, mono, 1, quality)
+        np.testing.assert_array_equal(kept, boxes)
+        shape = (48, 64) if mono else (48, 64, 3)
+        assert all(f.shape == shape and f.dtype == np.uint8 for f in out)
+        sources = [cv2.cvtColor(f, cv2.COLOR_BGR2GRAY) for f in frames] if mono else frames
+        return np.mean([np.abs(f.astype(int) - g).mean() for f, g in zip(out, sources)])
+
+    assert error(None) == 0.0  # read as they are
+    # noise is what JPEG discards first: the lower the quality, the more of it is lost
+    assert 0.0 < error(95) < error(10)
+    assert error(10, mono=True) > 0.0  # a mono8 frame stays one channel
 
 
 def test_unknown_sequence_exits_2_one_line(tmp_path, capsys):
