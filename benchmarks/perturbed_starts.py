@@ -65,8 +65,8 @@ footage of lower resolution than the shared sequences, and smaller targets
 (OpenCV's BGR-to-grey weights), as a monochrome camera's ``mono8`` images
 (docs/decisions.md#mono-camera).  ``--jpeg-quality 30`` runs every tracker on the frames encoded
 as JPEG at that quality and decoded again, as a compressed image stream delivers them
-(docs/decisions.md#jpeg-probe).  ``--figure recall`` scores every run by its recall instead of
-its average overlap: the frames a tracker reported lost score 0, as its published detections do
+(docs/decisions.md#jpeg-probe).  ``--figure recall`` measures every run by its recall instead of
+its average overlap: the frames a tracker reported lost count as 0, as its published detections do
 (docs/decisions.md#published-recall).
 """
 from __future__ import annotations
@@ -270,8 +270,8 @@ def main() -> None:
         '--figure',
         choices=sorted(FIGURES),
         default='ao',
-        help='what a run scores: ao, its average overlap; recall, the same with the frames the '
-        'tracker reported lost scored 0 (default: ao)',
+        help='what a run is measured by: ao, its average overlap; recall, the same with the '
+        'frames the tracker reported lost counted as 0 (default: ao)',
     )
     parser.add_argument('--jobs', type=int, default=2)
     parser.add_argument(

@@ -477,9 +477,9 @@ def test_search_prefers_a_window_the_occlusion_check_accepts(otb_root):
 
     From about frame 115 a parked car hides her legs; at frame 125 the EMD pulls the descent from
     the prediction 20 px down, where the translation filter's response is 0.02 (0.11 on her).
-    Scored by the EMD, filter and colour terms that window wins, every later frame is held, and by
-    frame 140 the window is off her (docs/decisions.md#test-bounds).  Preferring a descended window
-    the check accepts keeps it on her.
+    On the EMD, filter and colour terms of the score that window wins, every later frame is held,
+    and by frame 140 the window is off her (docs/decisions.md#test-bounds).  Preferring a
+    descended window the check accepts keeps it on her.
     """
     seq = load_sequence(otb_root / 'Woman')
     tracker = IemdTracker()

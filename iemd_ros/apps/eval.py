@@ -39,7 +39,7 @@ The evaluation is :mod:`iemd_ros.evaluation.ope`.
 
 Without a folder it evaluates every sequence of ``../shared/data/otb`` and ``../shared/data/uav``.
 Prints the average overlap, success AUC, precision at 20 px, the recall R (the average overlap
-with the frames the tracker reported lost scored 0) and fps per sequence and on average,
+with the frames the tracker reported lost counted as 0) and fps per sequence and on average,
 and writes ``results.json`` and one success plot per sequence plus an overall one into ``--out``.
 Bad input prints one line on stderr and exits with status 2.  ``--split`` keeps the training or the
 validation part of the fixed split (:mod:`iemd_ros.evaluation.split`); ``--published`` ranks the

@@ -322,7 +322,7 @@ class SequenceScores:
     overlap_gt_0, overlap_gt_04 : float
         Fractions of frames with overlap > 0 and > 0.4.
     recall : float
-        The average overlap with the frames the tracker did not report the target on scored 0
+        The average overlap with the frames the tracker did not report the target on counted as 0
         (VOT's long-term tracking recall): what its reports (published detections) are worth.
         Equal to ``average_overlap`` for a tracker that reports every frame.
     fps : float or None, optional

@@ -37,7 +37,7 @@ GT box of the first frame and then updated on every later frame without re-initi
 first frame counts as tracked with the GT box.  Scores are those of
 :mod:`iemd_ros.evaluation.metrics` (average overlap = the paper's table metric, OTB success AUC,
 precision@20px, overlap > 0 / > 0.4, and the recall ``R``: the average overlap with the frames a
-tracker reported failed, iEMD's lost frames, scored 0).  The mean over sequences is the plain mean
+tracker reported failed, iEMD's lost frames, as 0).  The mean over sequences is the plain mean
 of the per-sequence figures (OTB averages the per-sequence success curves), fps included.
 
 Speed: only the ``init``/``update`` calls are timed (image decoding is not); fps = frames / (init

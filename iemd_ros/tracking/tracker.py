@@ -134,8 +134,8 @@ class TrackResult:
     predicted_box: tuple[float, float, float, float] | None = None
     # why the window counts as lost, or why the models did not learn (held), with the figures
     reason: str = ''
-    # tracked, but the models did not learn and the size was kept (the occlusion check, or the
-    # EMD above the background's while the filter's peak does not say lost)
+    # tracked, but the models did not learn and the size did not change (the occlusion check, or
+    # the EMD above the background's while the filter's peak does not say lost)
     held: bool = False
     cause: Cause | None = None  # the reason's kind (None: tracked and learned)
 
