@@ -261,7 +261,7 @@ class TrackerConfig:
     lost_factor: float = param(
         1.0,
         'held when EMD > this x the background EMD measured at init (lost on a frame the '
-        'occlusion check holds, or without the translation filter)',
+        'occlusion check holds, while already lost, or without the translation filter)',
         range=(0.01, 100.0),
         decision='background-emd',
     )

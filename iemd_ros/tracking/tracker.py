@@ -408,10 +408,9 @@ class IemdTracker:
         # long as the filter's peak does not say lost: the box is still reported
         # (docs/decisions.md#emd-held)
         emd_held = cause is Cause.EMD_ABOVE_BACKGROUND and tracked and self._filter_holds()
-        if emd_held:
-            emd_reason, cause = reason, None
+        if emd_held:  # the EMD's cause and reason stay the result's
             new_center, new_size = final.center, best.model.size
-        if cause is None:  # lost until the peak is back to found_response x its mean: hysteresis
+        elif cause is None:  # lost until the peak is back to found_response x its mean: hysteresis
             cause, reason = self._peak_check(
                 cfg.found_response if self._lost else cfg.lost_response
             )
@@ -422,7 +421,7 @@ class IemdTracker:
             if redetected is not None:
                 return redetected
         # the window follows the local search (not out of the image), without learning
-        if cause is not None:
+        if cause is not None and not emd_held:
             kept = center if cause is Cause.OUT_OF_VIEW else new_center
             return self._lose(
                 kept,
@@ -441,11 +440,9 @@ class IemdTracker:
         self._lost, self._lost_frames, self._anchor = False, 0, None
         held = bool(best.held_reason) or emd_held
         self._center, self._size, self._angle = new_center, new_size, angle
-        if emd_held:
-            cause, reason = Cause.EMD_ABOVE_BACKGROUND, emd_reason
-        elif held:
+        if best.held_reason:
             cause, reason = Cause.LOW_RESPONSE, best.held_reason
-        else:
+        elif not emd_held:
             if self._peak_apce is not None:
                 self._peak_apce_sums += self._peak_apce
                 self._peak_apce_count += 1
