@@ -88,6 +88,7 @@ from iemd_ros.datasets.otb import load_sequence
 from iemd_ros.evaluation.metrics import paired_difference, score_sequence, valid_boxes
 from iemd_ros.evaluation.ope import make_tracker, run_tracker, sequence_names
 from iemd_ros.evaluation.split import PARTS, split_names
+from iemd_ros.messages.conversions import array_to_compressed_fields, compressed_to_array
 from iemd_ros.tracking.appearance import grey_levels
 import numpy as np
 
@@ -183,7 +184,7 @@ def _as_camera(
 
     That camera has ``factor`` times the frames' resolution, with ``mono`` one grey channel, and
     takes every ``every``-th frame; with ``jpeg_quality`` its frames come through a compressed
-    image stream, encoded as JPEG at that quality (OpenCV's encoder) and decoded again.
+    image stream, encoded as JPEG at that quality and decoded again as the node does.
 
     Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
@@ -200,8 +201,8 @@ def _as_camera(
             frame = cv2.resize(frame, size, interpolation=cv2.INTER_AREA)
             ratio = np.array([size[0] / w, size[1] / h])
         if jpeg_quality is not None:
-            _, jpeg = cv2.imencode('.jpg', frame, [cv2.IMWRITE_JPEG_QUALITY, jpeg_quality])
-            frame = cv2.imdecode(jpeg, cv2.IMREAD_UNCHANGED)
+            fields = array_to_compressed_fields(frame, 'jpeg', jpeg_quality)
+            frame = compressed_to_array(fields['format'], fields['data'])
         out.append(frame)
     return out, boxes * np.tile(ratio, 2)
 
