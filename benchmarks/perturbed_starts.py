@@ -51,7 +51,7 @@ with other TrackerConfig values (default: the defaults), each against the same p
 
 A difference between two trackers is printed run by run (``paired_difference``: the mean difference
 in points, its 95 % interval with whole sequences resampled, the runs better, worse and equal; then
-the mean difference per sequence):
+the mean difference per sequence and per start, in the order of the starts above):
 every configuration after the first against the first, and, with ``--against FILE``, every tracker
 of this run against the first of a run saved by ``--save FILE`` (the same starts, shift and
 resolution; another source tree, say).  A saved run records the digest of the
@@ -398,6 +398,7 @@ def _print_difference(
         f'{d.high:+.1f}; runs better / worse / equal {d.better} / {d.worse} / {d.equal}'
     )
     print('      by sequence: ' + ' '.join(f'{n} {v:+.1f}' for n, v in zip(names, d.per_sequence)))
+    print('      by start: ' + ' '.join(f'{v:+.1f}' for v in d.per_start))
 
 
 def _tracker_digest() -> str:

@@ -197,6 +197,12 @@ def test_a_paired_difference_gives_each_sequence_its_own_mean():
     assert paired_difference(ours, reference).per_sequence == pytest.approx((2.0, -1.0, 0.0))
 
 
+def test_a_paired_difference_gives_each_start_its_mean_over_the_sequences():
+    reference = np.zeros((3, 4))
+    ours = np.array([[1.0, 3.0, 1.0, 3.0], [0.0, 0.0, 0.0, -4.0], [2.0, 0.0, 0.0, -2.0]])
+    assert paired_difference(ours, reference).per_start == pytest.approx((1.0, 1.0, 1 / 3, -1.0))
+
+
 @pytest.mark.parametrize(
     'ours, reference, kwargs, message',
     [

@@ -534,6 +534,7 @@ class PairedDifference:
     worse: int  # runs where ours is lower
     equal: int  # runs with the same value
     per_sequence: tuple[float, ...]  # mean difference of each sequence's runs, in input order
+    per_start: tuple[float, ...]  # mean difference of each start over the sequences, input order
 
 
 def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) -> PairedDifference:
@@ -558,7 +559,7 @@ def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) ->
     -------
     PairedDifference
         The mean difference, its 95 % interval, the runs better, worse and equal, and the mean
-        difference per sequence.
+        difference per sequence and per start.
 
     Raises
     ------
@@ -591,4 +592,5 @@ def paired_difference(ours, reference, resamples: int = 10000, seed: int = 0) ->
         worse=int((diff < 0).sum()),
         equal=int((diff == 0).sum()),
         per_sequence=tuple(float(v) for v in per_sequence),
+        per_start=tuple(float(v) for v in diff.mean(axis=0)),
     )
