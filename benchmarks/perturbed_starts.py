@@ -65,9 +65,12 @@ footage of lower resolution than the shared sequences, and smaller targets
 (OpenCV's BGR-to-grey weights), as a monochrome camera's ``mono8`` images
 (docs/decisions.md#mono-camera).  ``--jpeg-quality 30`` runs every tracker on the frames encoded
 as JPEG at that quality and decoded again, as a compressed image stream delivers them
-(docs/decisions.md#jpeg-probe).  ``--figure recall`` measures every run by its recall instead of
-its average overlap: the frames a tracker reported lost count as 0, as its published detections do
-(docs/decisions.md#published-recall).
+(docs/decisions.md#jpeg-probe).  ``--exposure 1`` runs every tracker on frames whose levels are
+multiplied by a gain swinging 1 stop (a factor of 2) either way of 1, sinusoidally over
+``EXPOSURE_PERIOD`` frames, as a camera's auto exposure swings when it hunts
+(docs/decisions.md#exposure-probe).  ``--figure recall`` measures every run by its recall
+instead of its average overlap: the frames a tracker reported lost count as 0, as its published
+detections do (docs/decisions.md#published-recall).
 """
 from __future__ import annotations
 
@@ -113,10 +116,12 @@ SETTINGS = {
     'resolution': 1.0,
     'mono': False,
     'jpeg_quality': None,
+    'exposure': 0.0,
     'every': 1,
     'frame_rate': None,
     'figure': 'ao',
 }
+EXPOSURE_PERIOD = 60  # frames of one swing of --exposure's gain: 2 s at OTB's 30 Hz
 # the figures --figure chooses from, in the order run() returns them, with their short names
 FIGURES = {'ao': 'AO', 'recall': 'R'}
 
@@ -177,14 +182,22 @@ def run(job):
 
 
 def _as_camera(
-    frames, boxes, factor: float, mono: bool, every: int, jpeg_quality: int | None = None
+    frames,
+    boxes,
+    factor: float,
+    mono: bool,
+    every: int,
+    jpeg_quality: int | None = None,
+    exposure: float = 0.0,
 ) -> tuple[list, np.ndarray]:
     """
     Return the decoded frames and 0-based ground-truth boxes as another camera would give them.
 
     That camera has ``factor`` times the frames' resolution, with ``mono`` one grey channel, and
     takes every ``every``-th frame; with ``jpeg_quality`` its frames come through a compressed
-    image stream, encoded as JPEG at that quality and decoded again as the node does.
+    image stream, encoded as JPEG at that quality and decoded again as the node does; with
+    ``exposure`` its k-th frame's levels are multiplied by ``exposure_gain(k, exposure)`` (rounded,
+    at most 255) before that.
 
     Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
@@ -192,7 +205,8 @@ def _as_camera(
     """
     boxes = np.asarray(boxes, dtype=float)[::every]
     out, ratio = [], np.ones(2)
-    for frame in itertools.islice(frames, 0, None, every):
+    levels = np.arange(256.0)
+    for k, frame in enumerate(itertools.islice(frames, 0, None, every)):
         if mono:
             frame = grey_levels(frame)
         if factor != 1.0:
@@ -200,11 +214,23 @@ def _as_camera(
             size = (max(1, round(w * factor)), max(1, round(h * factor)))
             frame = cv2.resize(frame, size, interpolation=cv2.INTER_AREA)
             ratio = np.array([size[0] / w, size[1] / h])
+        if exposure:
+            table = np.minimum(np.round(levels * exposure_gain(k, exposure)), 255.0)
+            frame = cv2.LUT(frame, table.astype(np.uint8))
         if jpeg_quality is not None:
             fields = array_to_compressed_fields(frame, 'jpeg', jpeg_quality)
             frame = compressed_to_array(fields['format'], fields['data'])
         out.append(frame)
     return out, boxes * np.tile(ratio, 2)
+
+
+def exposure_gain(k: int, stops: float) -> float:
+    """
+    Return the gain of the ``k``-th frame: ``2 ** (stops sin(2 pi k / EXPOSURE_PERIOD))``.
+
+    1 on the first frame, ``2 ** stops`` a quarter period later.
+    """
+    return float(2.0 ** (stops * np.sin(2.0 * np.pi * k / EXPOSURE_PERIOD)))
 
 
 def main() -> None:
@@ -253,6 +279,14 @@ def main() -> None:
         'image stream delivers them (default: as read)',
     )
     parser.add_argument(
+        '--exposure',
+        type=float,
+        default=0.0,
+        metavar='STOPS',
+        help='frames multiplied by a gain swinging this many stops either way of 1 over '
+        f'{EXPOSURE_PERIOD} frames, as an auto exposure hunting, in [0, 3] (default: 0, none)',
+    )
+    parser.add_argument(
         '--frame-rate',
         type=positive_float,
         default=None,
@@ -288,6 +322,8 @@ def main() -> None:
         parser.error(f'--every must be >= 1, got {args.every}')
     if args.jpeg_quality is not None and not 1 <= args.jpeg_quality <= 100:
         parser.error(f'--jpeg-quality must be in 1-100, got {args.jpeg_quality}')
+    if not 0.0 <= args.exposure <= 3.0:
+        parser.error(f'--exposure must be in [0, 3], got {args.exposure}')
     rate = args.frame_rate or (None if args.every == 1 else TrackerConfig().reference_rate)
     interval = None if rate is None else args.every / rate
     settings = {key: getattr(args, key) for key in SETTINGS}
@@ -319,7 +355,7 @@ def main() -> None:
                     runs,
                     args.shift,
                     START_SETS[args.starts],
-                    (args.resolution, args.mono, args.every, args.jpeg_quality),
+                    (args.resolution, args.mono, args.every, args.jpeg_quality, args.exposure),
                     interval,
                 )
                 for name in names
@@ -339,6 +375,7 @@ def main() -> None:
         + ('' if args.resolution == 1.0 else f', frames at {args.resolution:g} of their size')
         + (', one-channel grey frames' if args.mono else '')
         + ('' if args.jpeg_quality is None else f', JPEG at quality {args.jpeg_quality}')
+        + ('' if not args.exposure else f', exposure swinging {args.exposure:g} stops')
         + ('' if args.every == 1 else f', every {args.every}th frame')
         + ('' if interval is None else f', iEMD told the frames are {interval * 1e3:.1f} ms apart')
     )

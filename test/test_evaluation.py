@@ -298,6 +298,7 @@ PERTURBED_STARTS = REPO / 'benchmarks' / 'perturbed_starts.py'
     [
         (['--frame-rate', 'inf'], "argument --frame-rate: must be a finite number > 0, got 'inf'"),
         (['--jpeg-quality', '0'], '--jpeg-quality must be in 1-100, got 0'),
+        (['--exposure', '-1'], '--exposure must be in [0, 3], got -1.0'),
     ],
 )
 def test_perturbed_starts_refuses_a_bad_camera_in_one_line(argv, match):
@@ -327,6 +328,30 @@ def test_perturbed_starts_jpeg_camera_compresses_at_its_quality_and_keeps_the_bo
     # noise is what JPEG discards first: the lower the quality, the more of it is lost
     assert 0.0 < error(95) < error(10)
     assert error(10, mono=True) > 0.0  # a mono8 frame stays one channel
+
+
+def test_perturbed_starts_exposure_multiplies_each_frames_levels_by_its_gain():
+    spec = importlib.util.spec_from_file_location('perturbed_starts', PERTURBED_STARTS)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    quarter = script.EXPOSURE_PERIOD // 4
+    n = 3 * quarter + 1
+    ramp = np.tile(np.arange(256, dtype=np.uint8), (2, 1))
+    frames = [np.dstack([ramp] * 3)] * n
+    boxes = [[1.0, 2.0, 10.0, 12.0]] * n
+    out, kept = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 1.0)
+    np.testing.assert_array_equal(kept, boxes)
+    levels = np.arange(256)
+    np.testing.assert_array_equal(out[0][0, :, 0], levels)  # gain 1 on the first frame
+    # a quarter period on, one stop up (saturating at 255); three quarters on, one stop down
+    np.testing.assert_array_equal(out[quarter][0, :, 1], np.minimum(2 * levels, 255))
+    np.testing.assert_array_equal(out[3 * quarter][1, :, 2], np.round(levels / 2.0))
+    # a twelfth of the period on, sin = 1/2: half the stops
+    assert script.exposure_gain(script.EXPOSURE_PERIOD // 12, 2.0) == pytest.approx(2.0)
+    # every other frame kept: the gain follows the frames the camera gives, a mono frame too
+    grey, _ = script._as_camera(iter(frames), boxes, 1.0, True, 2, None, 1.0)
+    assert grey[quarter].ndim == 2
+    np.testing.assert_array_equal(grey[quarter][0], np.minimum(2 * levels, 255))
 
 
 def test_unknown_sequence_exits_2_one_line(tmp_path, capsys):
