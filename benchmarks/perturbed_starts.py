@@ -195,9 +195,9 @@ def _as_camera(
 
     That camera has ``factor`` times the frames' resolution, with ``mono`` one grey channel, and
     takes every ``every``-th frame; with ``jpeg_quality`` its frames come through a compressed
-    image stream, encoded as JPEG at that quality and decoded again as the node does; with
-    ``exposure`` its k-th frame's levels are multiplied by ``exposure_gain(k, exposure)`` (rounded,
-    at most 255) before that.
+    image stream, encoded as JPEG at that quality and decoded again as the node does.  With
+    ``exposure`` the levels of the k-th frame it gives are multiplied by
+    ``exposure_gain(k, exposure)`` (rounded, at most 255), before any JPEG coding.
 
     Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
