@@ -68,9 +68,10 @@ as JPEG at that quality and decoded again, as a compressed image stream delivers
 (docs/decisions.md#jpeg-probe).  ``--exposure 1`` runs every tracker on frames whose levels are
 multiplied by a gain swinging 1 stop (a factor of 2) either way of 1, sinusoidally over
 ``EXPOSURE_PERIOD`` frames, as a camera's auto exposure swings when it hunts
-(docs/decisions.md#exposure-probe).  ``--figure recall`` measures every run by its recall
-instead of its average overlap: the frames a tracker reported lost count as 0, as its published
-detections do (docs/decisions.md#published-recall).
+(docs/decisions.md#exposure-probe).  ``--noise 8`` adds to every level Gaussian noise of standard
+deviation 8, as a sensor in low light (docs/decisions.md#noise-probe).  ``--figure recall``
+measures every run by its recall instead of its average overlap: the frames a tracker reported
+lost count as 0, as its published detections do (docs/decisions.md#published-recall).
 """
 from __future__ import annotations
 
@@ -117,6 +118,7 @@ SETTINGS = {
     'mono': False,
     'jpeg_quality': None,
     'exposure': 0.0,
+    'noise': 0.0,
     'every': 1,
     'frame_rate': None,
     'figure': 'ao',
@@ -189,6 +191,7 @@ def _as_camera(
     every: int,
     jpeg_quality: int | None = None,
     exposure: float = 0.0,
+    noise: float = 0.0,
 ) -> tuple[list, np.ndarray]:
     """
     Return the decoded frames and 0-based ground-truth boxes as another camera would give them.
@@ -197,7 +200,9 @@ def _as_camera(
     takes every ``every``-th frame; with ``jpeg_quality`` its frames come through a compressed
     image stream, encoded as JPEG at that quality and decoded again as the node does.  With
     ``exposure`` the levels of the k-th frame it gives are multiplied by
-    ``exposure_gain(k, exposure)`` (rounded, at most 255), before any JPEG coding.
+    ``exposure_gain(k, exposure)`` (rounded, at most 255); with ``noise``, Gaussian noise of that
+    standard deviation is added to each level (rounded, within 0-255; seeded by k, so that every
+    run sees the same noise), both before any JPEG coding.
 
     Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
@@ -217,6 +222,9 @@ def _as_camera(
         if exposure:
             table = np.minimum(np.round(levels * exposure_gain(k, exposure)), 255.0)
             frame = cv2.LUT(frame, table.astype(np.uint8))
+        if noise:
+            grain = np.random.default_rng(k).normal(0.0, noise, frame.shape)
+            frame = np.clip(np.round(frame + grain), 0, 255).astype(np.uint8)
         if jpeg_quality is not None:
             fields = array_to_compressed_fields(frame, 'jpeg', jpeg_quality)
             frame = compressed_to_array(fields['format'], fields['data'])
@@ -287,6 +295,14 @@ def main() -> None:
         f'{EXPOSURE_PERIOD} frames, as an auto exposure hunting, in [0, 3] (default: 0, none)',
     )
     parser.add_argument(
+        '--noise',
+        type=float,
+        default=0.0,
+        metavar='SIGMA',
+        help='Gaussian noise of this standard deviation added to every level, as a sensor in low '
+        'light, in [0, 64] (default: 0, none)',
+    )
+    parser.add_argument(
         '--frame-rate',
         type=positive_float,
         default=None,
@@ -324,6 +340,8 @@ def main() -> None:
         parser.error(f'--jpeg-quality must be in 1-100, got {args.jpeg_quality}')
     if not 0.0 <= args.exposure <= 3.0:
         parser.error(f'--exposure must be in [0, 3], got {args.exposure}')
+    if not 0.0 <= args.noise <= 64.0:
+        parser.error(f'--noise must be in [0, 64], got {args.noise}')
     rate = args.frame_rate or (None if args.every == 1 else TrackerConfig().reference_rate)
     interval = None if rate is None else args.every / rate
     settings = {key: getattr(args, key) for key in SETTINGS}
@@ -355,7 +373,14 @@ def main() -> None:
                     runs,
                     args.shift,
                     START_SETS[args.starts],
-                    (args.resolution, args.mono, args.every, args.jpeg_quality, args.exposure),
+                    (
+                        args.resolution,
+                        args.mono,
+                        args.every,
+                        args.jpeg_quality,
+                        args.exposure,
+                        args.noise,
+                    ),
                     interval,
                 )
                 for name in names
@@ -376,6 +401,7 @@ def main() -> None:
         + (', one-channel grey frames' if args.mono else '')
         + ('' if args.jpeg_quality is None else f', JPEG at quality {args.jpeg_quality}')
         + ('' if not args.exposure else f', exposure swinging {args.exposure:g} stops')
+        + ('' if not args.noise else f', Gaussian noise of std {args.noise:g} levels')
         + ('' if args.every == 1 else f', every {args.every}th frame')
         + ('' if interval is None else f', iEMD told the frames are {interval * 1e3:.1f} ms apart')
     )

@@ -299,6 +299,7 @@ PERTURBED_STARTS = REPO / 'benchmarks' / 'perturbed_starts.py'
         (['--frame-rate', 'inf'], "argument --frame-rate: must be a finite number > 0, got 'inf'"),
         (['--jpeg-quality', '0'], '--jpeg-quality must be in 1-100, got 0'),
         (['--exposure', '-1'], '--exposure must be in [0, 3], got -1.0'),
+        (['--noise', '100'], '--noise must be in [0, 64], got 100.0'),
     ],
 )
 def test_perturbed_starts_refuses_a_bad_camera_in_one_line(argv, match):
@@ -352,6 +353,26 @@ def test_perturbed_starts_exposure_multiplies_each_frames_levels_by_its_gain():
     grey, _ = script._as_camera(iter(frames), boxes, 1.0, True, 2, None, 1.0)
     assert grey[quarter].ndim == 2
     np.testing.assert_array_equal(grey[quarter][0], np.minimum(2 * levels, 255))
+
+
+def test_perturbed_starts_noise_adds_the_same_grain_of_its_deviation_to_every_run():
+    spec = importlib.util.spec_from_file_location('perturbed_starts', PERTURBED_STARTS)
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    grey, bright = np.full((60, 80, 3), 128, np.uint8), np.full((60, 80, 3), 250, np.uint8)
+    frames = [grey, grey, bright]
+    boxes = [[1.0, 2.0, 10.0, 12.0]] * 3
+    out, kept = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 0.0, 8.0)
+    np.testing.assert_array_equal(kept, boxes)
+    grain = out[0].astype(float) - 128.0
+    assert abs(grain.mean()) < 0.5 and 7.5 < grain.std() < 8.5
+    assert not np.array_equal(out[0][:, :, 0], out[0][:, :, 1])  # every level its own draw
+    assert not np.array_equal(out[0], out[1])  # a new draw each frame
+    assert out[2].max() == 255 and out[2].dtype == np.uint8  # within the levels
+    again, _ = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 0.0, 8.0)
+    np.testing.assert_array_equal(again[0], out[0])  # seeded: every run sees the same noise
+    clean, _ = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 0.0, 0.0)
+    np.testing.assert_array_equal(clean[0], frames[0])
 
 
 def test_unknown_sequence_exits_2_one_line(tmp_path, capsys):
