@@ -400,7 +400,7 @@ def main() -> None:
         + ('' if args.resolution == 1.0 else f', frames at {args.resolution:g} of their size')
         + (', one-channel grey frames' if args.mono else '')
         + ('' if args.jpeg_quality is None else f', JPEG at quality {args.jpeg_quality}')
-        + ('' if not args.exposure else f', exposure swinging {args.exposure:g} stops')
+        + ('' if not args.exposure else f', exposure times {2 ** args.exposure:g} either way')
         + ('' if not args.noise else f', Gaussian noise of std {args.noise:g} levels')
         + ('' if args.every == 1 else f', every {args.every}th frame')
         + ('' if interval is None else f', iEMD told the frames are {interval * 1e3:.1f} ms apart')
