@@ -83,6 +83,7 @@ import itertools
 import json
 from multiprocessing import Pool
 from pathlib import Path
+from typing import NamedTuple
 
 import cv2
 from iemd_ros import TrackerConfig, tracking
@@ -160,7 +161,7 @@ def run(job):
     """
     name, runs, shift, starts, camera, interval = job
     seq = load_sequence(name)
-    frames, truth = _as_camera(seq.frames(), seq.gt_boxes, *camera)
+    frames, truth = _as_camera(seq.frames(), seq.gt_boxes, camera)
     begins = []  # (first frame, box) of each start, the same for every tracker
     for dx, dy, scale, at in starts:
         k = start_frame(truth, at)
@@ -183,21 +184,23 @@ def run(job):
     return out
 
 
-def _as_camera(
-    frames,
-    boxes,
-    factor: float,
-    mono: bool,
-    every: int,
-    jpeg_quality: int | None = None,
-    exposure: float = 0.0,
-    noise: float = 0.0,
-) -> tuple[list, np.ndarray]:
+class Camera(NamedTuple):
+    """The camera a run's frames are converted to; each field is the option of its name."""
+
+    resolution: float = 1.0  # times the frames' width and height
+    mono: bool = False  # one grey channel
+    every: int = 1  # every N-th frame
+    jpeg_quality: int | None = None  # through a compressed stream at this JPEG quality
+    exposure: float = 0.0  # stops of the gain's swing
+    noise: float = 0.0  # standard deviation of the Gaussian noise, levels
+
+
+def _as_camera(frames, boxes, camera: Camera) -> tuple[list, np.ndarray]:
     """
     Return the decoded frames and 0-based ground-truth boxes as another camera would give them.
 
-    That camera has ``factor`` times the frames' resolution, with ``mono`` one grey channel, and
-    takes every ``every``-th frame; with ``jpeg_quality`` its frames come through a compressed
+    That camera has ``resolution`` times the frames' resolution, with ``mono`` one grey channel,
+    and takes every ``every``-th frame; with ``jpeg_quality`` its frames come through a compressed
     image stream, encoded as JPEG at that quality and decoded again as the node does.  With
     ``exposure`` the levels of the k-th frame it gives are multiplied by
     ``exposure_gain(k, exposure)`` (rounded, at most 255); with ``noise``, Gaussian noise of that
@@ -208,6 +211,7 @@ def _as_camera(
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
     ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
     """
+    factor, mono, every, jpeg_quality, exposure, noise = camera
     boxes = np.asarray(boxes, dtype=float)[::every]
     out, ratio = [], np.ones(2)
     levels = np.arange(256.0)
@@ -373,14 +377,7 @@ def main() -> None:
                     runs,
                     args.shift,
                     START_SETS[args.starts],
-                    (
-                        args.resolution,
-                        args.mono,
-                        args.every,
-                        args.jpeg_quality,
-                        args.exposure,
-                        args.noise,
-                    ),
+                    Camera(*(getattr(args, field) for field in Camera._fields)),
                     interval,
                 )
                 for name in names

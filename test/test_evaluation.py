@@ -293,6 +293,15 @@ def test_bad_arguments_exit_2_one_line(argv, match, capsys):
 PERTURBED_STARTS = REPO / 'benchmarks' / 'perturbed_starts.py'
 
 
+@pytest.fixture(scope='module')
+def script():
+    """``benchmarks/perturbed_starts.py`` imported as a module (benchmarks is no package)."""
+    spec = importlib.util.spec_from_file_location('perturbed_starts', PERTURBED_STARTS)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 @pytest.mark.parametrize(
     'argv, match',
     [
@@ -309,16 +318,14 @@ def test_perturbed_starts_refuses_a_bad_camera_in_one_line(argv, match):
     assert match in proc.stderr
 
 
-def test_perturbed_starts_jpeg_camera_compresses_at_its_quality_and_keeps_the_boxes():
-    spec = importlib.util.spec_from_file_location('perturbed_starts', PERTURBED_STARTS)
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
+def test_perturbed_starts_jpeg_camera_compresses_at_its_quality_and_keeps_the_boxes(script):
     rng = np.random.default_rng(0)
     frames = [rng.integers(0, 256, (48, 64, 3), dtype=np.uint8) for _ in range(3)]
     boxes = [[1.0, 2.0, 10.0, 12.0]] * 3
 
     def error(quality, mono=False):
-        out, kept = script._as_camera(iter(frames), boxes, 1.0, mono, 1, quality)
+        camera = script.Camera(mono=mono, jpeg_quality=quality)
+        out, kept = script._as_camera(iter(frames), boxes, camera)
         np.testing.assert_array_equal(kept, boxes)
         shape = (48, 64) if mono else (48, 64, 3)
         assert all(f.shape == shape and f.dtype == np.uint8 for f in out)
@@ -331,16 +338,13 @@ def test_perturbed_starts_jpeg_camera_compresses_at_its_quality_and_keeps_the_bo
     assert error(10, mono=True) > 0.0  # a mono8 frame stays one channel
 
 
-def test_perturbed_starts_exposure_multiplies_each_frames_levels_by_its_gain():
-    spec = importlib.util.spec_from_file_location('perturbed_starts', PERTURBED_STARTS)
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
+def test_perturbed_starts_exposure_multiplies_each_frames_levels_by_its_gain(script):
     quarter = script.EXPOSURE_PERIOD // 4
     n = 3 * quarter + 1
     ramp = np.tile(np.arange(256, dtype=np.uint8), (2, 1))
     frames = [np.dstack([ramp] * 3)] * n
     boxes = [[1.0, 2.0, 10.0, 12.0]] * n
-    out, kept = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 1.0)
+    out, kept = script._as_camera(iter(frames), boxes, script.Camera(exposure=1.0))
     np.testing.assert_array_equal(kept, boxes)
     levels = np.arange(256)
     np.testing.assert_array_equal(out[0][0, :, 0], levels)  # gain 1 on the first frame
@@ -350,28 +354,27 @@ def test_perturbed_starts_exposure_multiplies_each_frames_levels_by_its_gain():
     # a twelfth of the period on, sin = 1/2: half the stops
     assert script.exposure_gain(script.EXPOSURE_PERIOD // 12, 2.0) == pytest.approx(2.0)
     # every other frame kept: the gain follows the frames the camera gives, a mono frame too
-    grey, _ = script._as_camera(iter(frames), boxes, 1.0, True, 2, None, 1.0)
+    grey, _ = script._as_camera(
+        iter(frames), boxes, script.Camera(mono=True, every=2, exposure=1.0)
+    )
     assert grey[quarter].ndim == 2
     np.testing.assert_array_equal(grey[quarter][0], np.minimum(2 * levels, 255))
 
 
-def test_perturbed_starts_noise_adds_the_same_grain_of_its_deviation_to_every_run():
-    spec = importlib.util.spec_from_file_location('perturbed_starts', PERTURBED_STARTS)
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
+def test_perturbed_starts_noise_adds_the_same_grain_of_its_deviation_to_every_run(script):
     grey, bright = np.full((60, 80, 3), 128, np.uint8), np.full((60, 80, 3), 250, np.uint8)
     frames = [grey, grey, bright]
     boxes = [[1.0, 2.0, 10.0, 12.0]] * 3
-    out, kept = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 0.0, 8.0)
+    out, kept = script._as_camera(iter(frames), boxes, script.Camera(noise=8.0))
     np.testing.assert_array_equal(kept, boxes)
     grain = out[0].astype(float) - 128.0
     assert abs(grain.mean()) < 0.5 and 7.5 < grain.std() < 8.5
     assert not np.array_equal(out[0][:, :, 0], out[0][:, :, 1])  # every level its own draw
     assert not np.array_equal(out[0], out[1])  # a new draw each frame
     assert out[2].max() == 255 and out[2].dtype == np.uint8  # within the levels
-    again, _ = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 0.0, 8.0)
+    again, _ = script._as_camera(iter(frames), boxes, script.Camera(noise=8.0))
     np.testing.assert_array_equal(again[0], out[0])  # seeded: every run sees the same noise
-    clean, _ = script._as_camera(iter(frames), boxes, 1.0, False, 1, None, 0.0, 0.0)
+    clean, _ = script._as_camera(iter(frames), boxes, script.Camera())
     np.testing.assert_array_equal(clean[0], frames[0])
 
 
