@@ -399,7 +399,7 @@ def main() -> None:
         + ('' if args.jpeg_quality is None else f', JPEG at quality {args.jpeg_quality}')
         + ('' if not args.exposure else f', exposure times {2 ** args.exposure:g} either way')
         + ('' if not args.noise else f', Gaussian noise of std {args.noise:g} levels')
-        + ('' if args.every == 1 else f', every {args.every}th frame')
+        + ('' if args.every == 1 else f', one frame in {args.every}')
         + ('' if interval is None else f', iEMD told the frames are {interval * 1e3:.1f} ms apart')
     )
     overlaps = {}
