@@ -69,7 +69,9 @@ as JPEG at that quality and decoded again, as a compressed image stream delivers
 multiplied by a gain swinging 1 stop (a factor of 2) either way of 1, sinusoidally over
 ``EXPOSURE_PERIOD`` frames, as a camera's auto exposure swings when it hunts
 (docs/decisions.md#exposure-probe).  ``--noise 8`` adds to every level Gaussian noise of standard
-deviation 8, as a sensor in low light (docs/decisions.md#noise-probe).  ``--figure recall``
+deviation 8, as a sensor in low light (docs/decisions.md#noise-probe).  ``--blur 8`` smears every
+frame along a line 8 px long whose direction turns by the golden angle from frame to frame, as a
+shaking camera moves while its shutter is open (docs/decisions.md#blur-probe).  ``--figure recall``
 measures every run by its recall instead of its average overlap: the frames a tracker reported
 lost count as 0, as its published detections do (docs/decisions.md#published-recall).
 """
@@ -120,11 +122,13 @@ SETTINGS = {
     'jpeg_quality': None,
     'exposure': 0.0,
     'noise': 0.0,
+    'blur': 0.0,
     'every': 1,
     'frame_rate': None,
     'figure': 'ao',
 }
 EXPOSURE_PERIOD = 60  # frames of one swing of --exposure's gain: 2 s at OTB's 30 Hz
+BLUR_TURN = np.pi * (3.0 - np.sqrt(5.0))  # rad, the golden angle: --blur's turn per frame
 # the figures --figure chooses from, in the order run() returns them, with their short names
 FIGURES = {'ao': 'AO', 'recall': 'R'}
 
@@ -193,6 +197,7 @@ class Camera(NamedTuple):
     jpeg_quality: int | None = None  # through a compressed stream at this JPEG quality
     exposure: float = 0.0  # stops of the gain's swing
     noise: float = 0.0  # standard deviation of the Gaussian noise, levels
+    blur: float = 0.0  # length of the motion blur, px of the sequence's frames
 
 
 def _as_camera(frames, boxes, camera: Camera) -> tuple[list, np.ndarray]:
@@ -205,17 +210,20 @@ def _as_camera(frames, boxes, camera: Camera) -> tuple[list, np.ndarray]:
     ``exposure`` the levels of the k-th frame it gives are multiplied by
     ``exposure_gain(k, exposure)`` (rounded, at most 255); with ``noise``, Gaussian noise of that
     standard deviation is added to each level (rounded, within 0-255; seeded by k, so that every
-    run sees the same noise), both before any JPEG coding.
+    run sees the same noise), both before any JPEG coding.  With ``blur`` each frame, as read, is
+    first convolved with ``blur_kernel(k, blur)``.
 
     Each frame is converted as it is decoded, so a sequence is never held twice.  A box's 0-based
     corner and size scale by the resized frame's own ratio on each axis: pixel ``i`` spans
     ``[i - 1/2, i + 1/2]`` and the resize maps the image's edges onto each other.
     """
-    factor, mono, every, jpeg_quality, exposure, noise = camera
+    factor, mono, every, jpeg_quality, exposure, noise, blur = camera
     boxes = np.asarray(boxes, dtype=float)[::every]
     out, ratio = [], np.ones(2)
     levels = np.arange(256.0)
     for k, frame in enumerate(itertools.islice(frames, 0, None, every)):
+        if blur:
+            frame = cv2.filter2D(frame, -1, blur_kernel(k, blur), borderType=cv2.BORDER_REFLECT)
         if mono:
             frame = grey_levels(frame)
         if factor != 1.0:
@@ -243,6 +251,31 @@ def exposure_gain(k: int, stops: float) -> float:
     1 on the first frame, ``2 ** stops`` a quarter period later.
     """
     return float(2.0 ** (stops * np.sin(2.0 * np.pi * k / EXPOSURE_PERIOD)))
+
+
+def blur_kernel(k: int, length: float) -> np.ndarray:
+    """
+    Return the motion blur of the ``k``-th frame: a line ``length`` px long through the centre.
+
+    The line is at ``k * BLUR_TURN`` from the image's x axis (y down), sampled every 1/16 px
+    with bilinear weights; the kernel sums to 1 and is odd-sized, so it does not shift the
+    image.
+    """
+    half = int(np.ceil(length / 2.0)) + 1
+    t = np.linspace(-length / 2.0, length / 2.0, int(np.ceil(16.0 * length)) + 1)
+    x = half + t * np.cos(k * BLUR_TURN)
+    y = half + t * np.sin(k * BLUR_TURN)
+    x0, y0 = np.floor(x).astype(int), np.floor(y).astype(int)
+    fx, fy = x - x0, y - y0
+    kernel = np.zeros((2 * half + 1, 2 * half + 1))
+    for dy, dx, weight in (
+        (0, 0, (1 - fy) * (1 - fx)),
+        (0, 1, (1 - fy) * fx),
+        (1, 0, fy * (1 - fx)),
+        (1, 1, fy * fx),
+    ):
+        np.add.at(kernel, (y0 + dy, x0 + dx), weight)
+    return (kernel / kernel.sum()).astype(np.float32)
 
 
 def main() -> None:
@@ -307,6 +340,14 @@ def main() -> None:
         'light, in [0, 64] (default: 0, none)',
     )
     parser.add_argument(
+        '--blur',
+        type=float,
+        default=0.0,
+        metavar='PX',
+        help='frames smeared along a line this long, in px of the frames as read, turning by the '
+        'golden angle from frame to frame, as a shaking camera, in [0, 64] (default: 0, none)',
+    )
+    parser.add_argument(
         '--frame-rate',
         type=positive_float,
         default=None,
@@ -346,6 +387,8 @@ def main() -> None:
         parser.error(f'--exposure must be in [0, 3], got {args.exposure}')
     if not 0.0 <= args.noise <= 64.0:
         parser.error(f'--noise must be in [0, 64], got {args.noise}')
+    if not 0.0 <= args.blur <= 64.0:
+        parser.error(f'--blur must be in [0, 64], got {args.blur}')
     rate = args.frame_rate or (None if args.every == 1 else TrackerConfig().reference_rate)
     interval = None if rate is None else args.every / rate
     settings = {key: getattr(args, key) for key in SETTINGS}
@@ -399,6 +442,7 @@ def main() -> None:
         + ('' if args.jpeg_quality is None else f', JPEG at quality {args.jpeg_quality}')
         + ('' if not args.exposure else f', exposure times {2 ** args.exposure:g} either way')
         + ('' if not args.noise else f', Gaussian noise of std {args.noise:g} levels')
+        + ('' if not args.blur else f', motion blur {args.blur:g} px long')
         + ('' if args.every == 1 else f', one frame in {args.every}')
         + ('' if interval is None else f', iEMD told the frames are {interval * 1e3:.1f} ms apart')
     )

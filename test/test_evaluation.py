@@ -309,6 +309,7 @@ def script():
         (['--jpeg-quality', '0'], '--jpeg-quality must be in 1-100, got 0'),
         (['--exposure', '-1'], '--exposure must be in [0, 3], got -1.0'),
         (['--noise', '100'], '--noise must be in [0, 64], got 100.0'),
+        (['--blur', '-2'], '--blur must be in [0, 64], got -2.0'),
     ],
 )
 def test_perturbed_starts_refuses_a_bad_camera_in_one_line(argv, match):
@@ -374,6 +375,35 @@ def test_perturbed_starts_noise_adds_the_same_grain_of_its_deviation_to_every_ru
     assert out[2].max() == 255 and out[2].dtype == np.uint8  # within the levels
     again, _ = script._as_camera(iter(frames), boxes, script.Camera(noise=8.0))
     np.testing.assert_array_equal(again[0], out[0])  # seeded: every run sees the same noise
+    clean, _ = script._as_camera(iter(frames), boxes, script.Camera())
+    np.testing.assert_array_equal(clean[0], frames[0])
+
+
+def test_perturbed_starts_blur_smears_a_point_along_a_line_turning_every_frame(script):
+    point = np.zeros((41, 41, 3), np.uint8)
+    point[20, 20] = 240
+    frames = [point] * 3
+    boxes = [[1.0, 2.0, 10.0, 12.0]] * 3
+    out, kept = script._as_camera(iter(frames), boxes, script.Camera(blur=8.0))
+    np.testing.assert_array_equal(kept, boxes)
+    # the first frame's line is along x: 8 px through the point, from 4 px left of it to 4 right
+    lit = np.argwhere(out[0][:, :, 0] > 0)
+    assert set(lit[:, 0]) == {20}
+    assert lit[:, 1].min() == 16 and lit[:, 1].max() == 24
+    assert abs(int(out[0][:, :, 0].sum()) - 240) <= 8  # the light is spread, not lost
+    # each later frame's line is turned by the golden angle: its second moments show the direction
+    for k in (1, 2):
+        ys, xs = np.nonzero(out[k][:, :, 0] > 0)
+        weights = out[k][ys, xs, 0].astype(float)
+        cov = np.cov(np.vstack([xs, ys]), aweights=weights)
+        direction = np.linalg.eigh(cov)[1][:, -1]
+        cos = abs(direction @ [np.cos(k * script.BLUR_TURN), np.sin(k * script.BLUR_TURN)])
+        assert cos > 0.99
+        assert 0.5 * 8.0 ** 2 / 12 < np.linalg.eigvalsh(cov)[-1] < 1.5 * 8.0 ** 2 / 12
+    for k, length in ((0, 0.5), (3, 8.0), (5, 21.0)):
+        kernel = script.blur_kernel(k, length)
+        assert kernel.sum() == pytest.approx(1.0)
+        assert kernel.shape[0] % 2 == 1 and np.allclose(kernel, kernel[::-1, ::-1])  # no shift
     clean, _ = script._as_camera(iter(frames), boxes, script.Camera())
     np.testing.assert_array_equal(clean[0], frames[0])
 
