@@ -113,17 +113,26 @@ SCALES = tuple((0.0, 0.0, s, 0.0) for s in (0.8, 0.9, 1.1, 1.2))
 SEGMENTS = 20  # OTB's temporal robustness evaluation: starts at 20 evenly spaced frames
 TEMPORAL = tuple((0.0, 0.0, 1.0, k / SEGMENTS) for k in range(SEGMENTS))
 START_SETS = {'diagonal': DIAGONALS, 'sre': DIAGONALS + AXES + SCALES, 'tre': TEMPORAL}
-# the options a saved run records, and the value a file saved before an option existed ran with
+
+
+class Camera(NamedTuple):
+    """The camera a run's frames are converted to; each field is the option of its name."""
+
+    resolution: float = 1.0  # times the frames' width and height
+    mono: bool = False  # one grey channel
+    every: int = 1  # every N-th frame
+    jpeg_quality: int | None = None  # through a compressed stream at this JPEG quality
+    exposure: float = 0.0  # stops of the gain's swing
+    noise: float = 0.0  # standard deviation of the Gaussian noise, levels
+    blur: float = 0.0  # length of the motion blur, px of the sequence's frames
+
+
+# the options a saved run records, and the value a file saved before an option existed ran with:
+# its default, for the camera's options the default of Camera's field
 SETTINGS = {
     'starts': None,
     'shift': None,
-    'resolution': 1.0,
-    'mono': False,
-    'jpeg_quality': None,
-    'exposure': 0.0,
-    'noise': 0.0,
-    'blur': 0.0,
-    'every': 1,
+    **Camera._field_defaults,
     'frame_rate': None,
     'figure': 'ao',
 }
@@ -186,18 +195,6 @@ def run(job):
             )
         out.append(rows)
     return out
-
-
-class Camera(NamedTuple):
-    """The camera a run's frames are converted to; each field is the option of its name."""
-
-    resolution: float = 1.0  # times the frames' width and height
-    mono: bool = False  # one grey channel
-    every: int = 1  # every N-th frame
-    jpeg_quality: int | None = None  # through a compressed stream at this JPEG quality
-    exposure: float = 0.0  # stops of the gain's swing
-    noise: float = 0.0  # standard deviation of the Gaussian noise, levels
-    blur: float = 0.0  # length of the motion blur, px of the sequence's frames
 
 
 def _as_camera(frames, boxes, camera: Camera) -> tuple[list, np.ndarray]:
@@ -309,7 +306,6 @@ def main() -> None:
     parser.add_argument(
         '--resolution',
         type=float,
-        default=1.0,
         help='frames and ground truth resized by this factor, in (0, 1] (default: 1)',
     )
     parser.add_argument(
@@ -318,7 +314,6 @@ def main() -> None:
     parser.add_argument(
         '--jpeg-quality',
         type=int,
-        default=None,
         metavar='Q',
         help='frames encoded as JPEG at this quality, 1-100, and decoded again, as a compressed '
         'image stream delivers them (default: as read)',
@@ -326,7 +321,6 @@ def main() -> None:
     parser.add_argument(
         '--exposure',
         type=float,
-        default=0.0,
         metavar='STOPS',
         help='frames multiplied by a gain swinging this many stops either way of 1 over '
         f'{EXPOSURE_PERIOD} frames, as an auto exposure hunting, in [0, 3] (default: 0, none)',
@@ -334,7 +328,6 @@ def main() -> None:
     parser.add_argument(
         '--noise',
         type=float,
-        default=0.0,
         metavar='SIGMA',
         help='Gaussian noise of this standard deviation added to every level, as a sensor in low '
         'light, in [0, 64] (default: 0, none)',
@@ -342,7 +335,6 @@ def main() -> None:
     parser.add_argument(
         '--blur',
         type=float,
-        default=0.0,
         metavar='PX',
         help='frames smeared along a line this long, in px of the frames as read, turning by the '
         'golden angle from frame to frame, as a shaking camera, in [0, 64] (default: 0, none)',
@@ -357,7 +349,6 @@ def main() -> None:
     parser.add_argument(
         '--every',
         type=int,
-        default=1,
         help='every N-th frame only, as a camera at 1/N of the rate; iEMD is told the interval, '
         'N frames at --frame-rate or, unknown, at the default reference_rate '
         '(default: 1)',
@@ -376,6 +367,7 @@ def main() -> None:
     parser.add_argument(
         '--against', type=Path, help='compare with the first tracker of a run saved by --save'
     )
+    parser.set_defaults(**Camera._field_defaults)  # the camera's options
     args = parser.parse_args()
     if not 0.0 < args.resolution <= 1.0:
         parser.error(f'--resolution must be in (0, 1], got {args.resolution}')
